@@ -1,0 +1,146 @@
+// Ring MMS ("generalized vortex"), PROBLEMS.md section 1 and
+// 000_1dbcb8acb6dddab9.txt chapter 2. Every material circle of the ring
+// R_i <= R <= R_o turns rigidly by
+//   alpha(R, t) = g(t) h(R),   x = R [cos(Theta + alpha), sin(Theta + alpha)]   (eq. 2.1)
+// with h(R) = (1 - s^2)^2, s = (R - R_m) / w, R_m = (R_i + R_o)/2, w = (R_o - R_i)/2;
+// for the report's ring (0.75, 1.25) this is 1 - 32 (R-1)^2 + 256 (R-1)^4.
+// h = h' = 0 at both rims, so the rims are traction-free.
+//
+// One parameter set feeds the motion, the exact fields and the body force, so
+// they cannot drift apart.
+#pragma once
+
+#include <cmath>
+#include <numbers>
+
+#include "solver/material/neo_hookean.hpp"
+#include "solver/tensor.hpp"
+
+namespace mpmvv::mms {
+
+enum class RingTimeFunction {
+  cosine,  // g = (A/2)(1 - cos 2 pi t): the Sandia report; starts at rest
+  sine,    // g = A sin(pi t): the MMS paper; starts with v = R g'(0) h(R) e_theta
+};
+
+struct RingParameters {
+  double inner_radius = 0.75;   // R_i [m]
+  double outer_radius = 1.25;   // R_o [m]
+  double amplitude = 0.5;       // A [rad]
+  RingTimeFunction time_function = RingTimeFunction::cosine;
+  double lambda = 577.0;        // [Pa], report eq. 2.2
+  double mu = 385.0;            // [Pa]
+  double density = 1000.0;      // rho_0 [kg/m^3]
+};
+
+// Exact fields at one material point and time.
+struct RingState {
+  Vec2 position;        // x
+  Vec2 displacement;    // u = x - X
+  Vec2 velocity;        // v
+  Vec2 acceleration;    // a
+  Mat2 deformation_gradient;  // F
+  Mat2 cauchy_stress;   // sigma
+  Mat2 first_piola;     // P = J sigma F^-T
+  double angle;         // alpha
+};
+
+class RingMms {
+ public:
+  explicit RingMms(const RingParameters& p) : p_(p), material_{p.lambda, p.mu} {}
+
+  const RingParameters& parameters() const { return p_; }
+  const NeoHookean& material() const { return material_; }
+
+  // Time function g and its first two derivatives.
+  double g(double t) const {
+    using std::numbers::pi;
+    return p_.time_function == RingTimeFunction::cosine ? 0.5 * p_.amplitude * (1.0 - std::cos(2.0 * pi * t))
+                                                        : p_.amplitude * std::sin(pi * t);
+  }
+  double g_dot(double t) const {
+    using std::numbers::pi;
+    return p_.time_function == RingTimeFunction::cosine ? p_.amplitude * pi * std::sin(2.0 * pi * t)
+                                                        : p_.amplitude * pi * std::cos(pi * t);
+  }
+  double g_ddot(double t) const {
+    using std::numbers::pi;
+    return p_.time_function == RingTimeFunction::cosine ? 2.0 * p_.amplitude * pi * pi * std::cos(2.0 * pi * t)
+                                                        : -p_.amplitude * pi * pi * std::sin(pi * t);
+  }
+
+  // Radial profile h and its first two derivatives.
+  double h(double R) const {
+    const double s = scaled(R);
+    return (1.0 - s * s) * (1.0 - s * s);
+  }
+  double h_prime(double R) const {
+    const double s = scaled(R);
+    return -4.0 * s * (1.0 - s * s) / half_width();
+  }
+  double h_second(double R) const {
+    const double s = scaled(R);
+    return -4.0 * (1.0 - 3.0 * s * s) / (half_width() * half_width());
+  }
+
+  double angle(double R, double t) const { return g(t) * h(R); }
+
+  bool contains(const Vec2& X) const {
+    const double R = X.norm();
+    return R >= p_.inner_radius && R <= p_.outer_radius;
+  }
+
+  // Exact current position of the material point X.
+  Vec2 position(const Vec2& X, double t) const {
+    const double R = X.norm();
+    const double theta = std::atan2(X.y(), X.x()) + angle(R, t);
+    return {R * std::cos(theta), R * std::sin(theta)};
+  }
+
+  // All exact fields at reference point X and time t.
+  RingState state(const Vec2& X, double t) const {
+    const double R = X.norm();
+    const double Theta = std::atan2(X.y(), X.x());
+    const double alpha = angle(R, t);
+    const double theta = Theta + alpha;
+    const Vec2 e_r(std::cos(theta), std::sin(theta)), e_t(-std::sin(theta), std::cos(theta));
+    const Vec2 E_R(std::cos(Theta), std::sin(Theta)), E_T(-std::sin(Theta), std::cos(Theta));
+    const double alpha_t = g_dot(t) * h(R), alpha_tt = g_ddot(t) * h(R), alpha_R = g(t) * h_prime(R);
+    RingState s;
+    s.angle = alpha;
+    s.position = R * e_r;
+    s.displacement = s.position - X;
+    s.velocity = R * alpha_t * e_t;
+    s.acceleration = -R * alpha_t * alpha_t * e_r + R * alpha_tt * e_t;
+    // dx/dR = e_r + R alpha_R e_theta and (1/R) dx/dTheta = e_theta.
+    s.deformation_gradient = (e_r + R * alpha_R * e_t) * E_R.transpose() + e_t * E_T.transpose();
+    s.cauchy_stress = material_.cauchy_stress(s.deformation_gradient);
+    const double J = determinant(s.deformation_gradient);
+    s.first_piola = J * s.cauchy_stress * inverse(s.deformation_gradient).transpose();
+    return s;
+  }
+
+  // Body force per unit mass, eqs. 2.14-2.15, as components in the current
+  // polar basis at theta = Theta + alpha(R, t), rotated to Cartesian. R is the
+  // reference radius; lambda drops out because the motion keeps J = 1.
+  Vec2 body_force(const Vec2& X, double t) const {
+    const double R = X.norm();
+    const double Theta = std::atan2(X.y(), X.x());
+    const double gt = g(t), hR = h(R), hp = h_prime(R);
+    const double nu = p_.mu / p_.density;
+    const double b_r = -R * (g_dot(t) * hR) * (g_dot(t) * hR) + nu * R * (hp * gt) * (hp * gt);
+    const double b_t = R * g_ddot(t) * hR - nu * (3.0 * hp + R * h_second(R)) * gt;
+    const double theta = Theta + gt * hR;
+    const double c = std::cos(theta), s = std::sin(theta);
+    return {b_r * c - b_t * s, b_r * s + b_t * c};
+  }
+
+ private:
+  double half_width() const { return 0.5 * (p_.outer_radius - p_.inner_radius); }
+  double scaled(double R) const { return (R - 0.5 * (p_.inner_radius + p_.outer_radius)) / half_width(); }
+
+  RingParameters p_;
+  NeoHookean material_;
+};
+
+}  // namespace mpmvv::mms

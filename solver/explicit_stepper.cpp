@@ -1,0 +1,208 @@
+#include "explicit_stepper.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "shape/cpdi.hpp"
+#include "shape/gimp.hpp"
+#include "shape/linear.hpp"
+
+namespace mpmvv {
+
+const char* to_string(Method m) {
+  switch (m) {
+    case Method::linear: return "linear";
+    case Method::gimp: return "gimp";
+    case Method::cpdi: return "cpdi";
+  }
+  return "?";
+}
+
+const char* to_string(Scheme s) {
+  switch (s) {
+    case Scheme::usl: return "usl";
+    case Scheme::usf: return "usf";
+    case Scheme::musl: return "musl";
+  }
+  return "?";
+}
+
+const char* to_string(DeformationUpdate u) {
+  switch (u) {
+    case DeformationUpdate::forward_euler: return "forward-euler";
+    case DeformationUpdate::midpoint: return "midpoint";
+  }
+  return "?";
+}
+
+double p_wave_modulus(const MaterialModel& m) {
+  return std::visit([](const auto& material) { return material.p_wave_modulus(); }, m);
+}
+
+namespace {
+
+template <class Shape, class Material, DeformationUpdate U>
+class ExplicitStepper final : public Stepper {
+ public:
+  ExplicitStepper(Model model, Scheme scheme, Material material,
+                  std::shared_ptr<const BodyForce> body_force)
+      : Stepper(std::move(model)),
+        scheme_(scheme),
+        material_(material),
+        body_force_(std::move(body_force)) {
+    buffers_.resize(max_threads(), model_.grid.node_count());
+    if (body_force_) model_.particles.body_force.assign(model_.particles.size(), Vec2::Zero());
+    if (scheme_ == Scheme::musl) next_position_.resize(model_.particles.size());
+  }
+
+  void step(double t, double dt, double kick) override {
+    switch (scheme_) {
+      case Scheme::usl: step_usl(t, dt, kick); break;
+      case Scheme::usf: step_usf(t, dt, kick); break;
+      case Scheme::musl: step_musl(t, dt, kick); break;
+    }
+  }
+
+  ParticleScan scan() const override {
+    return scan_particles(Shape::bind(model_.grid, model_.particles), material_, model_.particles);
+  }
+
+  ParticleFault diagnose(std::size_t p) const override {
+    const Particles& P = model_.particles;
+    const Shape shape = Shape::bind(model_.grid, P);
+    const Vec2& x = P.position[p];
+    if (!(x.allFinite() && P.velocity[p].allFinite() && P.deformation_gradient[p].allFinite() &&
+          P.stress[p].allFinite()))
+      return {"nan", fmt::format("non-finite state at x = ({:.6g}, {:.6g})", x.x(), x.y())};
+    const double J = determinant(P.deformation_gradient[p]);
+    if (!(J > 0.0)) return {"non-positive J", fmt::format("J = {:.6g} at x = ({:.6g}, {:.6g})", J, x.x(), x.y())};
+    if (!shape.inside(p))
+      return {"outside grid", fmt::format("support of the particle at ({:.6g}, {:.6g}) leaves the grid", x.x(), x.y())};
+    return {"", ""};
+  }
+
+ private:
+  // Update stress last (002_c3305cb8b1bc1490.txt section 1.5): forces from the
+  // stress at t_n, then velocity, position, F and finally stress.
+  void step_usl(double t, double dt, double kick) {
+    Particles& P = model_.particles;
+    const Shape shape = Shape::bind(model_.grid, P);
+    map_mass_momentum_and_forces(shape, t);
+    update_grid_motion(fields_, kick);
+    apply_roller_walls(model_.grid, fields_);
+    move_tracers(dt);
+    grid_to_particles<kVelocity | kPosition | kDeformation, Shape, U>(shape, fields_, P, dt, kick);
+    update_stress(material_, P);
+  }
+
+  // Update stress first: F and stress from the grid velocity at t_n, then the
+  // forces of the new stress move the grid and the particles.
+  void step_usf(double t, double dt, double kick) {
+    Particles& P = model_.particles;
+    const Shape shape = Shape::bind(model_.grid, P);
+    particles_to_grid<kMass | kMomentum>(shape, P, buffers_, fields_);
+    grid_velocity_from_momentum(fields_);
+    apply_roller_walls(model_.grid, fields_);
+    grid_to_particles<kDeformation, Shape, U>(shape, fields_, P, dt, kick);
+    update_stress(material_, P);
+    if (body_force_) {
+      evaluate_body_force(t);
+      particles_to_grid<kInternalForce | kBodyForce>(shape, P, buffers_, fields_);
+    } else {
+      particles_to_grid<kInternalForce>(shape, P, buffers_, fields_);
+    }
+    update_grid_motion(fields_, kick);
+    apply_roller_walls(model_.grid, fields_);
+    move_tracers(dt);
+    grid_to_particles<kVelocity | kPosition, Shape, U>(shape, fields_, P, dt, kick);
+  }
+
+  // Modified USL: as USL, but the velocity gradient comes from the particle
+  // velocities at t_{n+1} mapped back to the grid, with the weights at x_n.
+  void step_musl(double t, double dt, double kick) {
+    Particles& P = model_.particles;
+    const Shape shape = Shape::bind(model_.grid, P);
+    map_mass_momentum_and_forces(shape, t);
+    update_grid_motion(fields_, kick);
+    apply_roller_walls(model_.grid, fields_);
+    move_tracers(dt);
+    grid_to_particles<kVelocity | kPosition, Shape, U>(shape, fields_, P, dt, kick, next_position_.data());
+    particles_to_grid<kMomentum>(shape, P, buffers_, fields_);
+    grid_velocity_from_momentum(fields_);
+    apply_roller_walls(model_.grid, fields_);
+    grid_to_particles<kDeformation, Shape, U>(shape, fields_, P, dt, kick);
+    P.position.swap(next_position_);
+    update_stress(material_, P);
+  }
+
+  void map_mass_momentum_and_forces(const Shape& shape, double t) {
+    Particles& P = model_.particles;
+    if (body_force_) {
+      evaluate_body_force(t);
+      particles_to_grid<kMass | kMomentum | kInternalForce | kBodyForce>(shape, P, buffers_, fields_);
+    } else {
+      particles_to_grid<kMass | kMomentum | kInternalForce>(shape, P, buffers_, fields_);
+    }
+  }
+
+  void evaluate_body_force(double t) {
+    const auto start = std::chrono::steady_clock::now();
+    body_force_->evaluate(t, model_.particles, model_.particles.body_force);
+    forcing_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+
+  void move_tracers(double dt) {
+    if (!model_.tracers.empty()) advect_tracers(model_.grid, fields_, model_.tracers, dt);
+  }
+
+  Scheme scheme_;
+  Material material_;
+  std::shared_ptr<const BodyForce> body_force_;
+  ScatterBuffers buffers_;
+  std::vector<Vec2> next_position_;  // MUSL only: x_{n+1} while x_n still sets the weights
+};
+
+template <class Shape, class Material>
+std::unique_ptr<Stepper> make_for_update(Model model, const SolverOptions& o, const Material& m,
+                                         std::shared_ptr<const BodyForce> body_force) {
+  switch (o.deformation_update) {
+    case DeformationUpdate::forward_euler:
+      return std::make_unique<ExplicitStepper<Shape, Material, DeformationUpdate::forward_euler>>(
+          std::move(model), o.scheme, m, std::move(body_force));
+    case DeformationUpdate::midpoint:
+      return std::make_unique<ExplicitStepper<Shape, Material, DeformationUpdate::midpoint>>(
+          std::move(model), o.scheme, m, std::move(body_force));
+  }
+  throw std::logic_error("unknown deformation update");
+}
+
+template <class Shape>
+std::unique_ptr<Stepper> make_for_shape(Model model, const SolverOptions& o, const MaterialModel& material,
+                                        std::shared_ptr<const BodyForce> body_force) {
+  return std::visit(
+      [&](const auto& m) { return make_for_update<Shape>(std::move(model), o, m, std::move(body_force)); },
+      material);
+}
+
+}  // namespace
+
+std::unique_ptr<Stepper> make_stepper(Model model, const SolverOptions& options,
+                                      const MaterialModel& material,
+                                      std::shared_ptr<const BodyForce> body_force) {
+  const std::size_t n = model.particles.size();
+  if (n == 0) throw std::invalid_argument("the scene seeded no particles");
+  if (options.method != Method::linear && model.particles.half_size.size() != n)
+    throw std::invalid_argument(fmt::format("method {} needs a particle domain (half_size) for every particle",
+                                            to_string(options.method)));
+  switch (options.method) {
+    case Method::linear: return make_for_shape<LinearShape>(std::move(model), options, material, std::move(body_force));
+    case Method::gimp: return make_for_shape<GimpShape>(std::move(model), options, material, std::move(body_force));
+    case Method::cpdi: return make_for_shape<CpdiShape>(std::move(model), options, material, std::move(body_force));
+  }
+  throw std::logic_error("unknown method");
+}
+
+}  // namespace mpmvv

@@ -1,0 +1,197 @@
+#include "hdf5.hpp"
+
+#include <stdexcept>
+
+namespace mpmvv::h5 {
+
+namespace {
+
+// HDF5 prints its own error stack by default; the exceptions below say what
+// failed instead.
+struct SilenceAutomaticErrorPrinting {
+  SilenceAutomaticErrorPrinting() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
+};
+const SilenceAutomaticErrorPrinting silence;
+
+[[noreturn]] void fail(const char* call, const std::string& what) {
+  throw std::runtime_error(std::string("HDF5 ") + call + " failed on " + what);
+}
+
+hid_t check(hid_t id, const char* call, const std::string& what) {
+  if (id < 0) fail(call, what);
+  return id;
+}
+
+void check_status(herr_t status, const char* call, const std::string& what) {
+  if (status < 0) fail(call, what);
+}
+
+std::string join(const std::string& parent, const std::string& name) {
+  return parent == "/" ? "/" + name : parent + "/" + name;
+}
+
+Handle scalar_space(const std::string& what) {
+  return Handle(check(H5Screate(H5S_SCALAR), "H5Screate", what), H5Sclose);
+}
+
+Handle simple_space(const std::vector<hsize_t>& dims, const std::string& what) {
+  return Handle(check(H5Screate_simple(int(dims.size()), dims.data(), nullptr), "H5Screate_simple", what),
+                H5Sclose);
+}
+
+Handle utf8_string_type(const std::string& what) {
+  Handle type(check(H5Tcopy(H5T_C_S1), "H5Tcopy", what), H5Tclose);
+  check_status(H5Tset_size(type.get(), H5T_VARIABLE), "H5Tset_size", what);
+  check_status(H5Tset_cset(type.get(), H5T_CSET_UTF8), "H5Tset_cset", what);
+  return type;
+}
+
+void write_attribute(hid_t parent, const std::string& name, hid_t type, hid_t space, const void* data,
+                     const std::string& what) {
+  if (H5Aexists(parent, name.c_str()) > 0)
+    check_status(H5Adelete(parent, name.c_str()), "H5Adelete", what);
+  Handle attr(check(H5Acreate2(parent, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT), "H5Acreate2", what),
+              H5Aclose);
+  check_status(H5Awrite(attr.get(), type, data), "H5Awrite", what);
+}
+
+void write_dataset(hid_t parent, const std::string& name, hid_t type, const std::vector<hsize_t>& dims,
+                   const void* data, const std::string& what) {
+  Handle space = simple_space(dims, what);
+  Handle set(check(H5Dcreate2(parent, name.c_str(), type, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+                   "H5Dcreate2", what),
+             H5Dclose);
+  check_status(H5Dwrite(set.get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), "H5Dwrite", what);
+}
+
+}  // namespace
+
+Handle& Handle::operator=(Handle&& o) noexcept {
+  if (this != &o) {
+    if (id_ >= 0 && closer_) closer_(id_);
+    id_ = o.id_;
+    closer_ = o.closer_;
+    o.id_ = H5I_INVALID_HID;
+  }
+  return *this;
+}
+
+Handle::~Handle() {
+  if (id_ >= 0 && closer_) closer_(id_);
+}
+
+Group Group::create_group(const std::string& name) {
+  const std::string p = join(path_, name);
+  return Group(Handle(check(H5Gcreate2(id(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), "H5Gcreate2", p),
+                      H5Gclose),
+               p);
+}
+
+Group Group::open_group(const std::string& name) const {
+  const std::string p = join(path_, name);
+  return Group(Handle(check(H5Gopen2(id(), name.c_str(), H5P_DEFAULT), "H5Gopen2", p), H5Gclose), p);
+}
+
+bool Group::has(const std::string& name) const {
+  const htri_t r = H5Lexists(id(), name.c_str(), H5P_DEFAULT);
+  if (r < 0) fail("H5Lexists", join(path_, name));
+  return r > 0;
+}
+
+void Group::set_attribute(const std::string& name, double value) {
+  const std::string what = path_ + "@" + name;
+  Handle space = scalar_space(what);
+  write_attribute(id(), name, H5T_NATIVE_DOUBLE, space.get(), &value, what);
+}
+
+void Group::set_attribute(const std::string& name, std::int64_t value) {
+  const std::string what = path_ + "@" + name;
+  Handle space = scalar_space(what);
+  write_attribute(id(), name, H5T_NATIVE_INT64, space.get(), &value, what);
+}
+
+void Group::set_attribute(const std::string& name, const std::string& value) {
+  const std::string what = path_ + "@" + name;
+  Handle space = scalar_space(what);
+  Handle type = utf8_string_type(what);
+  const char* data = value.c_str();
+  write_attribute(id(), name, type.get(), space.get(), &data, what);
+}
+
+void Group::set_attribute(const std::string& name, const std::vector<double>& values) {
+  const std::string what = path_ + "@" + name;
+  Handle space = simple_space({hsize_t(values.size())}, what);
+  write_attribute(id(), name, H5T_NATIVE_DOUBLE, space.get(), values.data(), what);
+}
+
+void Group::write(const std::string& name, const std::vector<double>& data, const std::vector<hsize_t>& dims) {
+  write_dataset(id(), name, H5T_NATIVE_DOUBLE, dims, data.data(), join(path_, name));
+}
+
+void Group::write(const std::string& name, const std::vector<std::int64_t>& data,
+                  const std::vector<hsize_t>& dims) {
+  write_dataset(id(), name, H5T_NATIVE_INT64, dims, data.data(), join(path_, name));
+}
+
+double Group::attribute_double(const std::string& name) const {
+  const std::string what = path_ + "@" + name;
+  Handle attr(check(H5Aopen(id(), name.c_str(), H5P_DEFAULT), "H5Aopen", what), H5Aclose);
+  double v = 0.0;
+  check_status(H5Aread(attr.get(), H5T_NATIVE_DOUBLE, &v), "H5Aread", what);
+  return v;
+}
+
+std::int64_t Group::attribute_int(const std::string& name) const {
+  const std::string what = path_ + "@" + name;
+  Handle attr(check(H5Aopen(id(), name.c_str(), H5P_DEFAULT), "H5Aopen", what), H5Aclose);
+  std::int64_t v = 0;
+  check_status(H5Aread(attr.get(), H5T_NATIVE_INT64, &v), "H5Aread", what);
+  return v;
+}
+
+std::string Group::attribute_string(const std::string& name) const {
+  const std::string what = path_ + "@" + name;
+  Handle attr(check(H5Aopen(id(), name.c_str(), H5P_DEFAULT), "H5Aopen", what), H5Aclose);
+  Handle type = utf8_string_type(what);
+  char* data = nullptr;
+  check_status(H5Aread(attr.get(), type.get(), &data), "H5Aread", what);
+  std::string value = data ? data : "";
+  H5free_memory(data);
+  return value;
+}
+
+std::vector<double> Group::read_doubles(const std::string& name, std::vector<hsize_t>* dims) const {
+  const std::string what = join(path_, name);
+  Handle set(check(H5Dopen2(id(), name.c_str(), H5P_DEFAULT), "H5Dopen2", what), H5Dclose);
+  Handle space(check(H5Dget_space(set.get()), "H5Dget_space", what), H5Sclose);
+  const int rank = check(H5Sget_simple_extent_ndims(space.get()), "H5Sget_simple_extent_ndims", what);
+  std::vector<hsize_t> d(std::size_t(rank), 0);
+  check(H5Sget_simple_extent_dims(space.get(), d.data(), nullptr), "H5Sget_simple_extent_dims", what);
+  hsize_t count = 1;
+  for (hsize_t x : d) count *= x;
+  std::vector<double> data(count);
+  if (count > 0)
+    check_status(H5Dread(set.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()), "H5Dread", what);
+  if (dims) *dims = d;
+  return data;
+}
+
+File File::create(const std::string& path) {
+  return File(Handle(check(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), "H5Fcreate", path),
+                     H5Fclose),
+              path);
+}
+
+File File::open_read(const std::string& path) {
+  return File(Handle(check(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), "H5Fopen", path), H5Fclose), path);
+}
+
+Group File::root() const {
+  return Group(Handle(check(H5Gopen2(handle_.get(), "/", H5P_DEFAULT), "H5Gopen2", path_ + ":/"), H5Gclose), "/");
+}
+
+void File::flush() const {
+  check_status(H5Fflush(handle_.get(), H5F_SCOPE_GLOBAL), "H5Fflush", path_);
+}
+
+}  // namespace mpmvv::h5

@@ -1,0 +1,60 @@
+// Compressible Mooney-Rivlin solid, plane strain. 000_1dbcb8acb6dddab9.txt
+// eq. 2.18 as printed is not stress-free at F = I; the code it was typeset from
+// (appendix C, MOONR.F, the STRESS lines) adds the volumetric term K ln J:
+//   sigma = (1/J) [ K ln J I + 2 J^(-2/3) (C1 + I1b C2) B - 2 J^(-4/3) C2 B.B
+//                   - (2/3)(C1 I1b + 2 C2 I2b) I ],
+// I1b = J^(-2/3) I1, I2b = J^(-4/3) I2, the invariants of the 3D B = F F^T.
+// This is the stress of W = C1 (I1b - 3) + C2 (I2b - 3) + (K/2)(ln J)^2.
+// Plane strain: B = diag(B_inplane, 1), so I1 = tr B2 + 1, I2 = det B2 + tr B2.
+#pragma once
+
+#include <cmath>
+
+#include "../tensor.hpp"
+
+namespace mpmvv {
+
+struct MooneyRivlin {
+  static constexpr const char* name = "mooney-rivlin";
+  double c1;             // [Pa]
+  double c2;             // [Pa]
+  double bulk_modulus;   // K [Pa]
+
+  template <class T>
+  Eigen::Matrix<T, 2, 2> cauchy_stress(const Eigen::Matrix<T, 2, 2>& F) const {
+    using std::log;
+    using std::pow;
+    using M = Eigen::Matrix<T, 2, 2>;
+    const T J = F(0, 0) * F(1, 1) - F(0, 1) * F(1, 0);
+    const M B = F * F.transpose();
+    const T trace_b = B(0, 0) + B(1, 1);
+    const T det_b = B(0, 0) * B(1, 1) - B(0, 1) * B(1, 0);
+    const T j23 = pow(J, T(-2.0 / 3.0));
+    const T j43 = j23 * j23;
+    const T i1_bar = j23 * (trace_b + T(1.0));
+    const T i2_bar = j43 * (det_b + trace_b);
+    const M I = M::Identity();
+    return (T(bulk_modulus) * log(J) * I + T(2.0) * j23 * (T(c1) + i1_bar * T(c2)) * B -
+            T(2.0) * j43 * T(c2) * (B * B) -
+            T(2.0 / 3.0) * (T(c1) * i1_bar + T(2.0) * T(c2) * i2_bar) * I) /
+           J;
+  }
+
+  double shear_modulus() const { return 2.0 * (c1 + c2); }
+  double p_wave_modulus() const { return bulk_modulus + 4.0 / 3.0 * shear_modulus(); }
+
+  // Estimate of rho c^2 at the current state, for the time step: the
+  // volumetric tangent (K (1 - ln J)) / J, the isochoric stiffness with the
+  // current I1b (2 (C1 + I1b C2) scaled as in the small-strain G), and the
+  // geometric term of the stress. Not a proven bound (unlike neo-Hookean).
+  double wave_modulus(const Mat2& F, const Mat2& sigma) const {
+    const double J = determinant(F);
+    const Mat2 B = F * F.transpose();
+    const double i1_bar = std::pow(J, -2.0 / 3.0) * (B.trace() + 1.0);
+    const double shear = 2.0 * (std::abs(c1) + std::abs(c2) * i1_bar / 3.0) * i1_bar / 3.0;
+    return (bulk_modulus * std::abs(1.0 - std::log(J)) + 4.0 / 3.0 * shear) / J +
+           std::max(largest_principal(sigma), 0.0);
+  }
+};
+
+}  // namespace mpmvv

@@ -1,0 +1,48 @@
+// What a scene hands the solver: the grid, the particles it seeded, the
+// material, the options of the method, and the optional stages it needs.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "grid.hpp"
+#include "material/mooney_rivlin.hpp"
+#include "material/neo_hookean.hpp"
+#include "particles.hpp"
+#include "stages.hpp"
+
+namespace mpmvv {
+
+enum class Method { linear, gimp, cpdi };
+enum class Scheme { usl, usf, musl };
+
+const char* to_string(Method m);
+const char* to_string(Scheme s);
+const char* to_string(DeformationUpdate u);
+
+using MaterialModel = std::variant<NeoHookean, MooneyRivlin>;
+double p_wave_modulus(const MaterialModel& m);
+
+struct SolverOptions {
+  Method method = Method::cpdi;
+  Scheme scheme = Scheme::usl;
+  DeformationUpdate deformation_update = DeformationUpdate::forward_euler;
+};
+
+// A body force supplied by the scene, per unit mass. One call fills the whole
+// array: the dispatch is per stage, not per particle.
+class BodyForce {
+ public:
+  virtual ~BodyForce() = default;
+  virtual void evaluate(double t, const Particles& particles, std::vector<Vec2>& body_force) const = 0;
+};
+
+struct Model {
+  GridGeometry grid;
+  Particles particles;
+  std::vector<Vec2> tracers;  // massless probe points; empty when the scene has none
+};
+
+}  // namespace mpmvv

@@ -1,0 +1,48 @@
+// Material points as structure-of-arrays. Fields a method or a scene does not
+// use stay empty: a linear-MPM run has no particle domains, a scene without
+// body force has no body-force array.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "tensor.hpp"
+
+namespace mpmvv {
+
+struct Particles {
+  // Advanced by every step.
+  std::vector<Vec2> position;              // x_p
+  std::vector<Vec2> velocity;              // v_p
+  std::vector<Mat2> deformation_gradient;  // F_p, in-plane part (F_zz = 1, plane strain)
+  std::vector<double> volume;              // V_p = det(F_p) V_p0, eq. 1.75
+  std::vector<Mat2> stress;                // Cauchy sigma_p, in-plane part
+
+  // Set once.
+  std::vector<double> mass;                // m_p = rho_0 V_p0
+  std::vector<double> reference_volume;    // V_p0
+  std::vector<Vec2> reference_position;    // X_p
+
+  // Method-specific: the half-size l_p of the reference particle domain along
+  // x and y. GIMP uses it as is (uGIMP: the size is not convected); CPDI spans
+  // its parallelogram with r_i = F_p (l_i e_i), eq. 1.97. Empty for linear MPM.
+  std::vector<Vec2> half_size;
+
+  // Scene-specific: body force per unit mass b_p (eq. 1.71 uses m_p b_p).
+  std::vector<Vec2> body_force;
+
+  std::size_t size() const { return position.size(); }
+
+  void resize(std::size_t n) {
+    position.resize(n, Vec2::Zero());
+    velocity.resize(n, Vec2::Zero());
+    deformation_gradient.resize(n, Mat2::Identity());
+    volume.resize(n, 0.0);
+    stress.resize(n, Mat2::Zero());
+    mass.resize(n, 0.0);
+    reference_volume.resize(n, 0.0);
+    reference_position.resize(n, Vec2::Zero());
+  }
+};
+
+}  // namespace mpmvv

@@ -1,0 +1,74 @@
+// CPDI with parallelogram particle domains (002_c3305cb8b1bc1490.txt section
+// 1.6.4, eqs. 1.94-1.100, in 2D). The domain of particle p is spanned by
+// r_1 = F_p (l_x e_x) and r_2 = F_p (l_y e_y) about its centroid (eq. 1.97);
+// the grid basis is interpolated bilinearly from its four corners (eq. 1.95),
+// which gives
+//   S_gp = (1/4) sum_c S_g(x_c),
+//   G_gp = (1/4) s_p^-T sum_c (xi_c, eta_c)^T S_g(x_c),   s_p = [r_1 r_2],
+// the 2D form of eq. 1.100 (the mean over the square of dN_c/dxi is xi_c / 4).
+#pragma once
+
+#include <cstddef>
+
+#include "../particles.hpp"
+#include "linear.hpp"
+#include "stencil.hpp"
+
+namespace mpmvv {
+
+struct CpdiShape {
+  static constexpr int stencil_size = 16;  // four nodes for each of four corners
+  static constexpr const char* name = "cpdi";
+
+  // Natural coordinates of the corners, counter-clockwise (eq. 1.99 in 2D).
+  static constexpr double corner_xi[4] = {-1.0, 1.0, 1.0, -1.0};
+  static constexpr double corner_eta[4] = {-1.0, -1.0, 1.0, 1.0};
+
+  const GridGeometry* grid;
+  const Vec2* position;
+  const Mat2* deformation_gradient;
+  const Vec2* half_size;
+
+  static CpdiShape bind(const GridGeometry& grid, const Particles& particles) {
+    return {&grid, particles.position.data(), particles.deformation_gradient.data(),
+            particles.half_size.data()};
+  }
+
+  // s_p = [r_1 r_2], the current domain half-vectors as columns (eq. 1.97).
+  Mat2 domain(std::size_t p) const {
+    Mat2 s = deformation_gradient[p];
+    s.col(0) *= half_size[p].x();
+    s.col(1) *= half_size[p].y();
+    return s;
+  }
+
+  Vec2 corner(std::size_t p, const Mat2& s, int c) const {
+    return position[p] + corner_xi[c] * s.col(0) + corner_eta[c] * s.col(1);
+  }
+
+  void evaluate(std::size_t p, Stencil<stencil_size>& st) const {
+    const Mat2 s = domain(p);
+    const Mat2 s_inv_t = inverse(s).transpose();
+    for (int c = 0; c < 4; ++c) {
+      int* node = st.node + 4 * c;
+      double* w = st.weight + 4 * c;
+      Vec2* g = st.gradient + 4 * c;
+      bilinear_cell(*grid, corner(p, s, c), node, w, g);
+      const Vec2 corner_gradient = 0.25 * (s_inv_t * Vec2(corner_xi[c], corner_eta[c]));
+      for (int k = 0; k < 4; ++k) {
+        g[k] = corner_gradient * w[k];
+        w[k] *= 0.25;
+      }
+    }
+  }
+
+  // Every corner of the domain lies in a cell of the grid.
+  bool inside(std::size_t p) const {
+    const Mat2 s = domain(p);
+    for (int c = 0; c < 4; ++c)
+      if (!inside_cells(*grid, grid_coordinate(*grid, corner(p, s, c)))) return false;
+    return true;
+  }
+};
+
+}  // namespace mpmvv

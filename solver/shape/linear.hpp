@@ -1,0 +1,56 @@
+// Standard MPM: the particle is a Dirac delta (eq. 1.88), so the effective
+// shape function is the bilinear hat of its cell, eqs. 1.86-1.87, with the
+// piecewise-constant gradient of eq. 1.89 (002_c3305cb8b1bc1490.txt section 1.6.1).
+#pragma once
+
+#include <cstddef>
+
+#include "../particles.hpp"
+#include "stencil.hpp"
+
+namespace mpmvv {
+
+// Bilinear hat weights and gradients of the four nodes of the cell holding x.
+// Shared by linear MPM, by CPDI at each domain corner, and by massless tracers.
+inline void bilinear_cell(const GridGeometry& grid, const Vec2& x, int* node, double* weight,
+                          Vec2* gradient) {
+  const Vec2 xi = grid_coordinate(grid, x);
+  const int i = static_cast<int>(std::floor(xi.x()));
+  const int j = static_cast<int>(std::floor(xi.y()));
+  const double fx = xi.x() - i, fy = xi.y() - j;  // in [0, 1)
+  const double gx = 1.0 - fx, gy = 1.0 - fy;
+  const double inv_h = 1.0 / grid.h;
+  node[0] = grid.node(i, j);
+  node[1] = grid.node(i + 1, j);
+  node[2] = grid.node(i, j + 1);
+  node[3] = grid.node(i + 1, j + 1);
+  weight[0] = gx * gy;
+  weight[1] = fx * gy;
+  weight[2] = gx * fy;
+  weight[3] = fx * fy;
+  gradient[0] = Vec2(-gy, -gx) * inv_h;
+  gradient[1] = Vec2(gy, -fx) * inv_h;
+  gradient[2] = Vec2(-fy, gx) * inv_h;
+  gradient[3] = Vec2(fy, fx) * inv_h;
+}
+
+struct LinearShape {
+  static constexpr int stencil_size = 4;
+  static constexpr const char* name = "linear";
+
+  const GridGeometry* grid;
+  const Vec2* position;
+
+  static LinearShape bind(const GridGeometry& grid, const Particles& particles) {
+    return {&grid, particles.position.data()};
+  }
+
+  void evaluate(std::size_t p, Stencil<stencil_size>& s) const {
+    bilinear_cell(*grid, position[p], s.node, s.weight, s.gradient);
+  }
+
+  // The particle's cell lies inside the grid.
+  bool inside(std::size_t p) const { return inside_cells(*grid, grid_coordinate(*grid, position[p])); }
+};
+
+}  // namespace mpmvv

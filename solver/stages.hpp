@@ -1,0 +1,292 @@
+// The stages of an explicit MPM step as free functions over particle and grid
+// arrays (002_c3305cb8b1bc1490.txt section 1.5). A stepper composes them in the
+// order of its stress-update scheme. Every choice (shape function, material,
+// which fields move) is a template parameter: it is made once per stage, never
+// per particle.
+//
+// Threads: particles are split statically over threads. Particle-to-grid
+// scatters into one private buffer per thread and the buffers are summed node
+// by node in thread order, so a run is bit-for-bit repeatable for a given
+// thread count.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <vector>
+
+#include "grid.hpp"
+#include "parallel.hpp"
+#include "particles.hpp"
+#include "shape/linear.hpp"
+#include "shape/stencil.hpp"
+
+namespace mpmvv {
+
+// ---------------------------------------------------------------- particle to grid
+
+// Which node sums a transfer produces.
+enum TransferField : unsigned {
+  kMass = 1u,           // m_g, eq. 1.69
+  kMomentum = 2u,       // m_g v_g, eq. 1.69
+  kInternalForce = 4u,  // -f_g^int = -sum_p V_p sigma_p G_gp, eq. 1.70
+  kBodyForce = 8u,      // f_g^body = sum_p m_p b_p S_gp
+};
+
+struct NodeSums {
+  double mass, momentum_x, momentum_y, force_x, force_y;
+};
+
+// One scatter buffer per thread, each covering the whole grid.
+struct ScatterBuffers {
+  std::vector<std::vector<NodeSums>> per_thread;
+
+  void resize(int threads, std::size_t nodes) {
+    per_thread.assign(std::size_t(threads), std::vector<NodeSums>(nodes));
+  }
+};
+
+// Sums the particle quantities selected by `Fields` onto the grid and stores
+// them in `g`, overwriting those node fields (the others are left as they are).
+template <unsigned Fields, class Shape>
+void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& buffers,
+                       GridFields& g) {
+  constexpr bool with_mass = Fields & kMass;
+  constexpr bool with_momentum = Fields & kMomentum;
+  constexpr bool with_internal = Fields & kInternalForce;
+  constexpr bool with_body = Fields & kBodyForce;
+  constexpr bool with_force = with_internal || with_body;
+  const std::size_t n = P.size();
+  const std::size_t nodes = g.mass.size();
+  const int threads = int(buffers.per_thread.size());
+
+#pragma omp parallel num_threads(threads)
+  {
+    NodeSums* sums = buffers.per_thread[std::size_t(thread_id())].data();
+    std::fill(sums, sums + nodes, NodeSums{0.0, 0.0, 0.0, 0.0, 0.0});
+    Stencil<Shape::stencil_size> s;
+#pragma omp for schedule(static)
+    for (std::size_t p = 0; p < n; ++p) {
+      shape.evaluate(p, s);
+      const double m = P.mass[p];
+      Vec2 momentum = Vec2::Zero(), body = Vec2::Zero();
+      Mat2 volume_stress = Mat2::Zero();
+      if constexpr (with_momentum) momentum = m * P.velocity[p];
+      if constexpr (with_body) body = m * P.body_force[p];
+      if constexpr (with_internal) volume_stress = P.volume[p] * P.stress[p];
+      for (int k = 0; k < Shape::stencil_size; ++k) {
+        NodeSums& node = sums[s.node[k]];
+        const double w = s.weight[k];
+        if constexpr (with_mass) node.mass += w * m;
+        if constexpr (with_momentum) {
+          node.momentum_x += w * momentum.x();
+          node.momentum_y += w * momentum.y();
+        }
+        if constexpr (with_force) {
+          Vec2 f = Vec2::Zero();
+          if constexpr (with_internal) f -= volume_stress * s.gradient[k];
+          if constexpr (with_body) f += w * body;
+          node.force_x += f.x();
+          node.force_y += f.y();
+        }
+      }
+    }
+    // The implicit barrier of `omp for` above: all buffers are complete.
+#pragma omp for schedule(static)
+    for (std::size_t i = 0; i < nodes; ++i) {
+      NodeSums total = buffers.per_thread[0][i];
+      for (int t = 1; t < threads; ++t) {
+        const NodeSums& b = buffers.per_thread[std::size_t(t)][i];
+        total.mass += b.mass;
+        total.momentum_x += b.momentum_x;
+        total.momentum_y += b.momentum_y;
+        total.force_x += b.force_x;
+        total.force_y += b.force_y;
+      }
+      if constexpr (with_mass) g.mass[i] = total.mass;
+      if constexpr (with_momentum) g.momentum[i] = Vec2(total.momentum_x, total.momentum_y);
+      if constexpr (with_force) g.force[i] = Vec2(total.force_x, total.force_y);
+    }
+  }
+}
+
+// ---------------------------------------------------------------- grid update
+
+// a_g = f_g / m_g (eq. 1.71) and v_g^L = v_g + a_g dt_kick (eq. 1.72). The
+// kick is the step itself, or under central differences the mean of the steps
+// on either side of t_n. Nodes no particle reaches carry no mass and stay at rest.
+inline void update_grid_motion(GridFields& g, double kick) {
+  const std::size_t nodes = g.mass.size();
+#pragma omp parallel for schedule(static)
+  for (std::size_t i = 0; i < nodes; ++i) {
+    if (g.mass[i] > 0.0) {
+      const double inv_m = 1.0 / g.mass[i];
+      g.acceleration[i] = g.force[i] * inv_m;
+      g.velocity[i] = g.momentum[i] * inv_m + g.acceleration[i] * kick;
+    } else {
+      g.acceleration[i].setZero();
+      g.velocity[i].setZero();
+    }
+  }
+}
+
+// v_g = (m_g v_g) / m_g without advancing it: the velocity a USF step takes its
+// gradient from, and the remapped velocity of MUSL.
+inline void grid_velocity_from_momentum(GridFields& g) {
+  const std::size_t nodes = g.mass.size();
+#pragma omp parallel for schedule(static)
+  for (std::size_t i = 0; i < nodes; ++i)
+    g.velocity[i] = g.mass[i] > 0.0 ? Vec2(g.momentum[i] / g.mass[i]) : Vec2::Zero();
+}
+
+// Roller (symmetry) walls on the four sides of the domain: nodes on a wall keep
+// no velocity and no acceleration normal to it; tangential motion is free.
+inline void apply_roller_walls(const GridGeometry& grid, GridFields& g) {
+  const int nx = grid.nodes_x(), ny = grid.nodes_y();
+  for (int j = 0; j < ny; ++j) {
+    for (int i : {0, nx - 1}) {
+      g.velocity[grid.node(i, j)].x() = 0.0;
+      g.acceleration[grid.node(i, j)].x() = 0.0;
+    }
+  }
+  for (int i = 0; i < nx; ++i) {
+    for (int j : {0, ny - 1}) {
+      g.velocity[grid.node(i, j)].y() = 0.0;
+      g.acceleration[grid.node(i, j)].y() = 0.0;
+    }
+  }
+}
+
+// ---------------------------------------------------------------- grid to particle
+
+// How F advances over a step from the velocity gradient L (section 1.5.1).
+enum class DeformationUpdate {
+  forward_euler,  // Delta F = I + L dt, eq. 1.74 (first order)
+  midpoint,       // Delta F = (I - L dt/2)^-1 (I + L dt/2): second order, and an
+                  // exact rotation when L is skew (the Cayley form of eq. 1.78)
+};
+
+template <DeformationUpdate U>
+inline Mat2 deformation_increment(const Mat2& L, double dt) {
+  if constexpr (U == DeformationUpdate::forward_euler) {
+    return Mat2::Identity() + dt * L;
+  } else {
+    const Mat2 half = 0.5 * dt * L;
+    return inverse(Mat2::Identity() - half) * (Mat2::Identity() + half);
+  }
+}
+
+// What a grid-to-particle transfer updates.
+enum ParticleUpdate : unsigned {
+  kVelocity = 1u,     // v_p += dt_kick sum_g S_gp a_g (eq. 1.76)
+  kPosition = 2u,     // x_p += dt sum_g S_gp v_g^L (eq. 1.76)
+  kDeformation = 4u,  // L_p = sum_g v_g (x) G_gp (eq. 1.73); F_p <- Delta F F_p and
+                      // V_p = det(F_p) V_p0 (eqs. 1.74-1.75; the product of the
+                      // increments' determinants that eq. 1.75 accumulates, without
+                      // its round-off drift)
+};
+
+// Every update reads the grid at the particle's position at the start of the
+// stage. New positions go to `position_out`, which may be P.position itself
+// (each particle reads its own position before writing it) or, when a later
+// stage still needs the old positions, another array.
+template <unsigned Updates, class Shape, DeformationUpdate U = DeformationUpdate::forward_euler>
+void grid_to_particles(const Shape& shape, const GridFields& g, Particles& P, double dt, double kick,
+                       Vec2* position_out = nullptr) {
+  constexpr bool with_velocity = Updates & kVelocity;
+  constexpr bool with_position = Updates & kPosition;
+  constexpr bool with_deformation = Updates & kDeformation;
+  if (position_out == nullptr) position_out = P.position.data();
+  const std::size_t n = P.size();
+#pragma omp parallel
+  {
+    Stencil<Shape::stencil_size> s;
+#pragma omp for schedule(static)
+    for (std::size_t p = 0; p < n; ++p) {
+      shape.evaluate(p, s);
+      Vec2 acceleration = Vec2::Zero(), velocity = Vec2::Zero();
+      Mat2 L = Mat2::Zero();
+      for (int k = 0; k < Shape::stencil_size; ++k) {
+        const int i = s.node[k];
+        if constexpr (with_velocity) acceleration += s.weight[k] * g.acceleration[i];
+        if constexpr (with_position) velocity += s.weight[k] * g.velocity[i];
+        if constexpr (with_deformation) L += g.velocity[i] * s.gradient[k].transpose();
+      }
+      if constexpr (with_deformation) {
+        P.deformation_gradient[p] = deformation_increment<U>(L, dt) * P.deformation_gradient[p];
+        P.volume[p] = determinant(P.deformation_gradient[p]) * P.reference_volume[p];
+      }
+      if constexpr (with_velocity) P.velocity[p] += kick * acceleration;
+      if constexpr (with_position) position_out[p] = P.position[p] + dt * velocity;
+    }
+  }
+}
+
+// ---------------------------------------------------------------- constitutive update
+
+template <class Material>
+void update_stress(const Material& material, Particles& P) {
+  const std::size_t n = P.size();
+#pragma omp parallel for schedule(static)
+  for (std::size_t p = 0; p < n; ++p) P.stress[p] = material.cauchy_stress(P.deformation_gradient[p]);
+}
+
+// ---------------------------------------------------------------- tracers
+
+// Massless probe points move with the grid velocity, interpolated with the
+// bilinear hat: they sample the motion the method computes without changing
+// it. A tracer that leaves the grid becomes NaN.
+inline void advect_tracers(const GridGeometry& grid, const GridFields& g, std::vector<Vec2>& tracers,
+                           double dt) {
+  for (Vec2& x : tracers) {
+    if (!inside_cells(grid, grid_coordinate(grid, x))) {
+      x.setConstant(std::numeric_limits<double>::quiet_NaN());
+      continue;
+    }
+    int node[4];
+    double w[4];
+    Vec2 grad[4];
+    bilinear_cell(grid, x, node, w, grad);
+    Vec2 v = Vec2::Zero();
+    for (int k = 0; k < 4; ++k) v += w[k] * g.velocity[node[k]];
+    x += dt * v;
+  }
+}
+
+// ---------------------------------------------------------------- health and time step
+
+struct ParticleScan {
+  double max_signal_speed = 0.0;  // max_p (c_p + |v_p|)
+  std::size_t first_unhealthy;    // lowest index of a particle that stops the run, or size()
+};
+
+template <class Shape>
+bool particle_healthy(const Shape& shape, const Particles& P, std::size_t p) {
+  const double J = determinant(P.deformation_gradient[p]);
+  return P.position[p].allFinite() && P.velocity[p].allFinite() &&
+         P.deformation_gradient[p].allFinite() && P.stress[p].allFinite() && J > 0.0 &&
+         shape.inside(p);
+}
+
+// One pass over particles: the largest signal speed c_p + |v_p|, with c_p the
+// material's wave speed bound at the particle's current state and density
+// rho_p = m_p / V_p, and the first particle whose state stops the run.
+template <class Shape, class Material>
+ParticleScan scan_particles(const Shape& shape, const Material& material, const Particles& P) {
+  const std::size_t n = P.size();
+  double max_speed = 0.0;
+  std::size_t first = n;
+#pragma omp parallel for schedule(static) reduction(max : max_speed) reduction(min : first)
+  for (std::size_t p = 0; p < n; ++p) {
+    if (!particle_healthy(shape, P, p)) {
+      first = std::min(first, p);
+      continue;
+    }
+    const double density = P.mass[p] / P.volume[p];
+    const double c = std::sqrt(material.wave_modulus(P.deformation_gradient[p], P.stress[p]) / density);
+    max_speed = std::max(max_speed, c + P.velocity[p].norm());
+  }
+  return {max_speed, first};
+}
+
+}  // namespace mpmvv

@@ -1,0 +1,123 @@
+#include "time_loop.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+namespace mpmvv {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+}  // namespace
+
+const char* to_string(TimeIntegration t) {
+  switch (t) {
+    case TimeIntegration::symplectic_euler: return "symplectic-euler";
+    case TimeIntegration::central_difference: return "central-difference";
+  }
+  return "?";
+}
+
+RunOutcome run_time_loop(Stepper& stepper, const TimeLoopOptions& options, RunObserver& observer,
+                         const ProgressSink& progress, double progress_interval_seconds) {
+  if (options.output_times.empty() || options.output_times.back() != options.end_time)
+    throw std::invalid_argument("output times must end at the end time");
+
+  RunOutcome out;
+  const auto start = Clock::now();
+  auto last_report = start;
+  const std::size_t n = stepper.model().particles.size();
+  const double h = stepper.model().grid.h;
+  // A step this small means the signal speed has run away.
+  const double smallest_step = 1e-12 * options.end_time;
+
+  auto fail = [&](const ParticleScan& scan, double t) {
+    const ParticleFault fault = stepper.diagnose(scan.first_unhealthy);
+    out.failure_reason = fault.reason;
+    out.failure_detail = fault.detail;
+    out.failure_time = t;
+    out.failure_step = out.steps;
+    out.failure_particle = static_cast<long long>(scan.first_unhealthy);
+  };
+
+  observer.initial(stepper);
+  double t = 0.0;
+  double previous_dt = 0.0;
+  std::size_t next_output = 0;
+  ParticleScan scan = stepper.scan();
+  if (scan.first_unhealthy < n) fail(scan, t);
+
+  while (out.failure_reason.empty() && next_output < options.output_times.size()) {
+    double dt = options.cfl * h / scan.max_signal_speed;
+    if (!std::isfinite(dt) || dt < smallest_step) {
+      out.failure_reason = "time step collapsed";
+      out.failure_detail = "CFL step " + std::to_string(dt) + " s";
+      out.failure_time = t;
+      out.failure_step = out.steps;
+      break;
+    }
+    if (out.steps == 0) out.dt_first = dt;
+    out.dt_min = out.steps == 0 ? dt : std::min(out.dt_min, dt);
+    out.dt_max = out.steps == 0 ? dt : std::max(out.dt_max, dt);
+
+    // Land on the next output time; split the last stretch in two rather than
+    // leave a sliver of a step.
+    const double target = options.output_times[next_output];
+    const double remaining = target - t;
+    bool lands = false;
+    if (remaining <= dt * (1.0 + 1e-12)) {
+      dt = remaining;
+      lands = true;
+    } else if (remaining < 2.0 * dt) {
+      dt = 0.5 * remaining;
+    }
+
+    const double kick = options.time_integration == TimeIntegration::symplectic_euler ? dt
+                        : out.steps == 0                                              ? 0.5 * dt
+                                                                                      : 0.5 * (previous_dt + dt);
+    stepper.step(t, dt, kick);
+    previous_dt = dt;
+    ++out.steps;
+    t = lands ? target : t + dt;
+    observer.after_step(t, stepper);
+
+    scan = stepper.scan();
+    if (scan.first_unhealthy < n) {
+      fail(scan, t);
+      break;
+    }
+    if (lands) {
+      observer.at_output(next_output, t, stepper);
+      ++next_output;
+      out.outputs_written = next_output;
+    }
+
+    if (progress && seconds_since(last_report) >= progress_interval_seconds) {
+      last_report = Clock::now();
+      const double elapsed = seconds_since(start);
+      const double rate = double(out.steps) * double(n) / elapsed;
+      const double eta = t > 0.0 ? elapsed * (options.end_time - t) / t : 0.0;
+      progress({out.steps, t, options.end_time, rate, eta, false});
+    }
+  }
+
+  out.time_reached = t;
+  out.completed = out.failure_reason.empty();
+  out.wall_seconds = seconds_since(start);
+  out.forcing_seconds = stepper.forcing_seconds();
+  out.particle_steps = out.steps * static_cast<long long>(n);
+  if (progress) {
+    const double rate = out.wall_seconds > 0.0 ? double(out.particle_steps) / out.wall_seconds : 0.0;
+    progress({out.steps, t, options.end_time, rate, 0.0, true});
+  }
+  return out;
+}
+
+}  // namespace mpmvv

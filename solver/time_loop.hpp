@@ -1,0 +1,78 @@
+// Advances a stepper to the end time with the CFL time step, lands exactly on
+// every output time, and turns a particle that stops the run into data: the
+// status, the reason, the time, the step and the particle.
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "explicit_stepper.hpp"
+
+namespace mpmvv {
+
+// How velocities sit in time. Both use the update of eqs. 1.72 and 1.76; they
+// differ in the kick, the time over which the acceleration at t_n acts.
+enum class TimeIntegration {
+  // Velocities at t_n, kick = dt: first order (the update as written).
+  symplectic_euler,
+  // Velocities at half steps t_{n+1/2} (central differences, leapfrog): the
+  // first kick is dt_0 / 2 and later kicks are (dt_{n-1} + dt_n) / 2, so
+  // changing the step (CFL, landing on an output time) keeps second order.
+  central_difference,
+};
+
+const char* to_string(TimeIntegration t);
+
+struct TimeLoopOptions {
+  double end_time = 1.0;
+  // dt = cfl h / max_p (c_p + |v_p|): the material's wave speed bound at the
+  // particle's current state plus its speed.
+  double cfl = 0.5;
+  TimeIntegration time_integration = TimeIntegration::central_difference;
+  // Strictly increasing, positive; the last one is the end time.
+  std::vector<double> output_times;
+};
+
+struct RunOutcome {
+  bool completed = false;
+  std::string failure_reason;  // empty when completed
+  std::string failure_detail;
+  double failure_time = std::numeric_limits<double>::quiet_NaN();
+  long long failure_step = -1;
+  long long failure_particle = -1;
+  double time_reached = 0.0;
+  long long steps = 0;
+  long long particle_steps = 0;
+  double wall_seconds = 0.0;
+  double forcing_seconds = 0.0;
+  double dt_first = std::numeric_limits<double>::quiet_NaN();  // from the CFL condition
+  double dt_min = std::numeric_limits<double>::quiet_NaN();
+  double dt_max = std::numeric_limits<double>::quiet_NaN();
+  std::size_t outputs_written = 0;
+};
+
+class RunObserver {
+ public:
+  virtual ~RunObserver() = default;
+  virtual void initial(const Stepper&) {}
+  virtual void after_step(double /*t*/, const Stepper&) {}
+  virtual void at_output(std::size_t /*index*/, double /*t*/, const Stepper&) {}
+};
+
+struct Progress {
+  long long step;
+  double time;
+  double end_time;
+  double particle_steps_per_second;
+  double eta_seconds;
+  bool final;
+};
+using ProgressSink = std::function<void(const Progress&)>;
+
+RunOutcome run_time_loop(Stepper& stepper, const TimeLoopOptions& options, RunObserver& observer,
+                         const ProgressSink& progress = {}, double progress_interval_seconds = 1.0);
+
+}  // namespace mpmvv

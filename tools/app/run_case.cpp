@@ -1,0 +1,183 @@
+#include "run_case.hpp"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <fmt/ostream.h>
+
+#include "config.hpp"
+#include "scene.hpp"
+#include "solver/parallel.hpp"
+
+namespace mpmvv::app {
+
+namespace fs = std::filesystem;
+
+std::string version_string() {
+  return fmt::format("mpmvv {} (commit {}; built with: {})", MPMVV_VERSION, MPMVV_GIT_COMMIT, MPMVV_FEATURES);
+}
+
+namespace {
+
+Config load(const std::string& scene_file, const std::vector<std::string>& overrides) {
+  return load_scene_file(
+      scene_file,
+      [](const std::string& name) -> std::optional<std::vector<KeySpec>> {
+        const SceneType* t = find_scene_type(name);
+        if (!t) return std::nullopt;
+        return t->keys();
+      },
+      overrides);
+}
+
+std::string compact(const Config& c) {
+  std::string s;
+  for (const KeySpec& k : c.specs()) s += fmt::format(" {}={}", k.name, format_value(c.value(k.name)));
+  return s;
+}
+
+void set_key_attribute(h5::Group& root, const std::string& name, const Value& v) {
+  std::visit(
+      [&](const auto& x) {
+        using T = std::decay_t<decltype(x)>;
+        if constexpr (std::is_same_v<T, std::int64_t>) root.set_attribute(name, x);
+        else if constexpr (std::is_same_v<T, double>) root.set_attribute(name, x);
+        else if constexpr (std::is_same_v<T, std::string>) root.set_attribute(name, x);
+        else root.set_attribute(name, x);
+      },
+      v);
+}
+
+void write_results_file(const std::string& path, const RunRequest& request, const Config& config,
+                        const SceneCase& scene, const RunOutcome& o) {
+  h5::File file = h5::File::create(path);
+  h5::Group root = file.root();
+  // Every scene key as an attribute of its own, then what the run measured.
+  for (const KeySpec& k : config.specs()) set_key_attribute(root, k.name, config.value(k.name));
+  root.set_attribute("scene", config.scene());
+  root.set_attribute("configuration", config.to_toml());
+  root.set_attribute("scene_file", request.scene_file);
+  std::string overrides;
+  for (const std::string& s : request.overrides) overrides += (overrides.empty() ? "" : "\n") + s;
+  root.set_attribute("overrides", overrides);
+  root.set_attribute("command_line", request.command_line);
+  root.set_attribute("version", version_string());
+  root.set_attribute("threads", std::int64_t(max_threads()));
+  root.set_attribute("status", o.completed ? "completed" : "failed");
+  root.set_attribute("failure_reason", o.failure_reason);
+  root.set_attribute("failure_detail", o.failure_detail);
+  root.set_attribute("failure_time", o.failure_time);
+  root.set_attribute("failure_step", std::int64_t(o.failure_step));
+  root.set_attribute("failure_particle", std::int64_t(o.failure_particle));
+  root.set_attribute("time_reached", o.time_reached);
+  root.set_attribute("steps", std::int64_t(o.steps));
+  root.set_attribute("particle_count", std::int64_t(scene.particle_count()));
+  root.set_attribute("particle_steps", std::int64_t(o.particle_steps));
+  root.set_attribute("wall_time_s", o.wall_seconds);
+  root.set_attribute("solver_time_s", o.wall_seconds - o.forcing_seconds);
+  root.set_attribute("forcing_time_s", o.forcing_seconds);
+  root.set_attribute("particle_steps_per_second", o.wall_seconds > 0 ? double(o.particle_steps) / o.wall_seconds : 0.0);
+  root.set_attribute("h", scene.cell_size());
+  root.set_attribute("dt", o.dt_first);
+  root.set_attribute("dt_min", o.dt_min);
+  root.set_attribute("dt_max", o.dt_max);
+  scene.write_results(root);
+  file.flush();
+}
+
+ProgressSink progress_printer(std::ostream& err) {
+  const bool tty = isatty(fileno(stderr));
+  return [&err, tty](const Progress& p) {
+    const std::string line =
+        fmt::format("step {:>7}  t = {:.4g} / {:.4g} s  {:.3g} particle-steps/s  ETA {:.0f} s", p.step, p.time,
+                    p.end_time, p.particle_steps_per_second, p.eta_seconds);
+    if (tty) {
+      fmt::print(err, "\r{:<78}", p.final ? fmt::format("step {:>7}  t = {:.4g} s  done", p.step, p.time) : line);
+      if (p.final) fmt::print(err, "\n");
+    } else if (!p.final) {
+      fmt::print(err, "{}\n", line);
+    }
+    err.flush();
+  };
+}
+
+}  // namespace
+
+std::string describe_configuration(const std::string& scene_file, const std::vector<std::string>& overrides) {
+  const Config c = load(scene_file, overrides);
+  std::string s = fmt::format("scene = \"{}\"  # {}\n", c.scene(), find_scene_type(c.scene())->summary);
+  for (const KeySpec& k : c.specs())
+    s += fmt::format("{} = {}\n    # {}; {} (from {})\n", k.name, format_value(c.value(k.name)), k.help,
+                     k.describe_range(), c.origin(k.name).source);
+  return s;
+}
+
+std::string describe_scenes() {
+  std::string s;
+  for (const SceneType& t : scene_types()) {
+    s += fmt::format("{}: {}\n", t.name, t.summary);
+    for (const KeySpec& k : t.keys())
+      s += fmt::format("  {:<24} default {:<12} {}; {}\n", k.name, format_value(k.default_value), k.help,
+                       k.describe_range());
+  }
+  return s;
+}
+
+int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
+  std::unique_ptr<SceneCase> scene;
+  Config config("", {});
+  std::string output = request.output;
+  try {
+    config = load(request.scene_file, request.overrides);
+    scene = find_scene_type(config.scene())->build(config);
+    if (output.empty()) output = fs::path(request.scene_file).stem().string() + ".h5";
+    if (fs::path(output).extension() != ".h5")
+      throw ConfigError(fmt::format("-o {}: the results file must end in .h5", output));
+    const fs::path parent = fs::absolute(output).parent_path();
+    std::error_code ec;
+    fs::create_directories(parent, ec);
+    if (ec) throw ConfigError(fmt::format("-o {}: cannot create directory {}: {}", output, parent.string(), ec.message()));
+  } catch (const ConfigError& e) {
+    fmt::print(err, "mpmvv run: {}\n", e.what());
+    return 2;
+  }
+  set_threads(request.threads);
+
+  if (!request.quiet)
+    fmt::print(err, "mpmvv run {} -> {} ({} threads)\nconfiguration:{}\n", request.scene_file, output, max_threads(),
+               compact(config));
+  const RunOutcome o = scene->run(request.quiet ? ProgressSink{} : progress_printer(err));
+
+  // Write next to the target and rename: a killed run never leaves a file that
+  // looks whole.
+  const std::string partial = output + ".partial";
+  try {
+    write_results_file(partial, request, config, *scene, o);
+    fs::rename(partial, output);
+  } catch (const std::exception& e) {
+    std::error_code ec;
+    fs::remove(partial, ec);
+    fmt::print(err, "mpmvv run: writing {} failed: {}\n", output, e.what());
+    return 2;
+  }
+
+  const double rate = o.wall_seconds > 0 ? double(o.particle_steps) / o.wall_seconds : 0.0;
+  if (o.completed)
+    fmt::print(out, "{} {}: completed t = {:.4g} s in {} steps, {:.3g} s wall ({:.3g} s forcing), {} particles, h = {:.4g} m, {:.3g} particle-steps/s\n",
+               config.scene(), config.text("method"), o.time_reached, o.steps, o.wall_seconds, o.forcing_seconds,
+               scene->particle_count(), scene->cell_size(), rate);
+  else
+    fmt::print(out, "{} {}: FAILED at t = {:.4g} s, step {}, particle {}: {} ({})\n", config.scene(),
+               config.text("method"), o.failure_time, o.failure_step, o.failure_particle, o.failure_reason,
+               o.failure_detail);
+  scene->print_summary(out);
+  fmt::print(out, "results: {}\n", output);
+  return o.completed ? 0 : 1;
+}
+
+}  // namespace mpmvv::app

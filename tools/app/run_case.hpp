@@ -1,0 +1,34 @@
+// One case end to end: read and check the scene file and overrides, run it,
+// write the results file atomically, print the error table.
+#pragma once
+
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+namespace mpmvv::app {
+
+struct RunRequest {
+  std::string scene_file;
+  std::vector<std::string> overrides;  // "key=value"
+  std::string output;                  // results file; empty: <scene file stem>.h5
+  bool quiet = false;                  // no echo, no progress
+  bool describe = false;               // print the resolved configuration and stop
+  int threads = 0;                     // 0: the OpenMP default
+  std::string command_line;
+};
+
+// Exit status: 0 the run completed; 1 the solver stopped it (results written,
+// status "failed"); 2 bad input (nothing run).
+int run_case(const RunRequest& request, std::ostream& out, std::ostream& err);
+
+// The resolved configuration of a scene file with overrides, one key per line
+// with its meaning and allowed range; throws ConfigError.
+std::string describe_configuration(const std::string& scene_file, const std::vector<std::string>& overrides);
+
+// Every scene and its keys.
+std::string describe_scenes();
+
+std::string version_string();
+
+}  // namespace mpmvv::app

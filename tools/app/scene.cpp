@@ -1,0 +1,103 @@
+#include "scene.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+namespace mpmvv::app {
+
+std::unique_ptr<SceneCase> build_ring_case(const Config& config);
+std::vector<KeySpec> ring_keys();
+
+const std::vector<SceneType>& scene_types() {
+  static const std::vector<SceneType> types = {
+      {"ring", "ring MMS under a manufactured body force (PROBLEMS.md section 1)", ring_keys, build_ring_case},
+  };
+  return types;
+}
+
+const SceneType* find_scene_type(const std::string& name) {
+  for (const SceneType& t : scene_types())
+    if (t.name == name) return &t;
+  return nullptr;
+}
+
+std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_time,
+                                 std::vector<double> default_output_times) {
+  const double inf = std::numeric_limits<double>::infinity();
+  return {
+      {"method", KeyKind::text, std::string("cpdi"), "shape functions: linear (standard MPM), gimp (uGIMP), cpdi",
+       -inf, inf, false, false, {"linear", "gimp", "cpdi"}},
+      {"scheme", KeyKind::text, std::string("usl"), "stress update: usl (update stress last), usf (first), musl (modified USL)",
+       -inf, inf, false, false, {"usl", "usf", "musl"}},
+      {"deformation_update", KeyKind::text, std::string("forward-euler"),
+       "F increment: forward-euler (I + L dt, eq. 1.74) or midpoint ((I - L dt/2)^-1 (I + L dt/2))", -inf, inf,
+       false, false, {"forward-euler", "midpoint"}},
+      {"time_integration", KeyKind::text, std::string("central-difference"),
+       "central-difference (velocities at half steps, second order) or symplectic-euler (velocities at whole "
+       "steps, first order); both use eqs. 1.72 and 1.76",
+       -inf, inf, false, false, {"central-difference", "symplectic-euler"}},
+      {"cells", KeyKind::integer, default_cells, "cells across the domain along each axis", 4, 20000},
+      {"particles_per_direction", KeyKind::integer, std::int64_t(2),
+       "particles per cell along each axis (2 means 4 per cell in 2D)", 1, 16},
+      {"cfl", KeyKind::real, 0.3,
+       "time step as a fraction of h / max(wave speed + particle speed); an undeformed 2D grid is stable to about "
+       "1/sqrt(2), large deformation lowers the limit (the ring at A = 1 on 256 cells fails above 0.35)",
+       0.0, 1.0, true, false},
+      {"end_time", KeyKind::real, default_end_time, "time at which the run stops [s]", 0.0, inf, true},
+      {"output_times", KeyKind::real_list, std::move(default_output_times),
+       "times at which probes and errors are recorded [s]; later than end_time are dropped, end_time is always one",
+       0.0, inf, true},
+  };
+}
+
+SolverOptions solver_options(const Config& c) {
+  SolverOptions o;
+  const std::string& m = c.text("method");
+  o.method = m == "linear" ? Method::linear : m == "gimp" ? Method::gimp : Method::cpdi;
+  const std::string& s = c.text("scheme");
+  o.scheme = s == "usf" ? Scheme::usf : s == "musl" ? Scheme::musl : Scheme::usl;
+  o.deformation_update =
+      c.text("deformation_update") == "midpoint" ? DeformationUpdate::midpoint : DeformationUpdate::forward_euler;
+  return o;
+}
+
+TimeLoopOptions time_loop_options(const Config& c) {
+  TimeLoopOptions o;
+  o.end_time = c.real("end_time");
+  o.cfl = c.real("cfl");
+  o.time_integration = c.text("time_integration") == "symplectic-euler" ? TimeIntegration::symplectic_euler
+                                                                       : TimeIntegration::central_difference;
+  const std::vector<double>& times = c.reals("output_times");
+  for (std::size_t i = 1; i < times.size(); ++i)
+    if (!(times[i] > times[i - 1]))
+      c.reject("output_times", fmt::format("must be strictly increasing ({} follows {})", times[i], times[i - 1]));
+  for (double t : times)
+    if (t < o.end_time) o.output_times.push_back(t);
+  o.output_times.push_back(o.end_time);
+  return o;
+}
+
+void write_particles(h5::Group& root, const Particles& P) {
+  h5::Group g = root.create_group("particles");
+  const std::size_t n = P.size();
+  std::vector<double> X(2 * n), x(2 * n), v(2 * n), V(n), J(n);
+  for (std::size_t p = 0; p < n; ++p) {
+    X[2 * p] = P.reference_position[p].x();
+    X[2 * p + 1] = P.reference_position[p].y();
+    x[2 * p] = P.position[p].x();
+    x[2 * p + 1] = P.position[p].y();
+    v[2 * p] = P.velocity[p].x();
+    v[2 * p + 1] = P.velocity[p].y();
+    V[p] = P.volume[p];
+    J[p] = determinant(P.deformation_gradient[p]);
+  }
+  g.write("reference_position", X, {n, 2});
+  g.write("position", x, {n, 2});
+  g.write("velocity", v, {n, 2});
+  g.write("volume", V, {n});
+  g.write("J", J, {n});
+}
+
+}  // namespace mpmvv::app

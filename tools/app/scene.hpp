@@ -1,0 +1,56 @@
+// A scene: geometry, material, loading, the exact solution and the probes
+// where error is measured. It names the solver stages it needs; the rest are
+// absent from its run.
+#pragma once
+
+#include <iosfwd>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "config.hpp"
+#include "solver/io/hdf5.hpp"
+#include "solver/model.hpp"
+#include "solver/time_loop.hpp"
+
+namespace mpmvv::app {
+
+// One configured case of a scene, ready to run.
+class SceneCase {
+ public:
+  virtual ~SceneCase() = default;
+  // Steps the scene to its end time (or to the step that stopped it).
+  virtual RunOutcome run(const ProgressSink& progress) = 0;
+  // Cell size, for the results file.
+  virtual double cell_size() const = 0;
+  virtual std::size_t particle_count() const = 0;
+  // Writes particles, probes and errors under `root`.
+  virtual void write_results(h5::Group& root) const = 0;
+  // The error table a person reads at the end of a run.
+  virtual void print_summary(std::ostream& out) const = 0;
+};
+
+struct SceneType {
+  std::string name;
+  std::string summary;
+  std::vector<KeySpec> (*keys)();
+  // Checks the rules that tie keys together and builds the case; throws
+  // ConfigError naming the key.
+  std::unique_ptr<SceneCase> (*build)(const Config&);
+};
+
+const std::vector<SceneType>& scene_types();
+const SceneType* find_scene_type(const std::string& name);
+
+// Keys every solver-driven scene shares: method, scheme, resolution, time.
+std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_time,
+                                 std::vector<double> default_output_times);
+SolverOptions solver_options(const Config& config);
+// The output times that lie in (0, end_time], with end_time always last.
+TimeLoopOptions time_loop_options(const Config& config);
+
+// Writes the particle arrays every results file carries.
+void write_particles(h5::Group& root, const Particles& particles);
+
+}  // namespace mpmvv::app
