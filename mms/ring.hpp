@@ -120,19 +120,42 @@ class RingMms {
     return s;
   }
 
-  // Body force per unit mass, eqs. 2.14-2.15, as components in the current
-  // polar basis at theta = Theta + alpha(R, t), rotated to Cartesian. R is the
-  // reference radius; lambda drops out because the motion keeps J = 1.
+  // The factors of the motion: the radial profile at a material radius and the
+  // time function at a time. The body force below is assembled from them, so a
+  // caller that keeps the radial factors of each particle evaluates exactly the
+  // same expression.
+  struct Radial {
+    double R, h, h_prime, h_second;
+  };
+  struct Temporal {
+    double g, g_dot, g_ddot;
+  };
+  Radial radial(double R) const { return {R, h(R), h_prime(R), h_second(R)}; }
+  Temporal temporal(double t) const { return {g(t), g_dot(t), g_ddot(t)}; }
+
+  // Body force per unit mass, eqs. 2.14-2.15, as components (b_r, b_theta) in
+  // the current polar basis at theta = Theta + alpha(R, t), R the reference
+  // radius. lambda drops out because the motion keeps J = 1.
+  Vec2 polar_body_force(const Radial& r, const Temporal& q) const {
+    const double nu = p_.mu / p_.density;
+    const double rate = q.g_dot * r.h, shear = r.h_prime * q.g;
+    return {-r.R * rate * rate + nu * r.R * shear * shear,
+            r.R * q.g_ddot * r.h - nu * (3.0 * r.h_prime + r.R * r.h_second) * q.g};
+  }
+
+  // The same force in Cartesian components: rotated by theta, where the
+  // reference angle enters through (cos Theta, sin Theta).
+  Vec2 body_force(const Radial& r, double cos_Theta, double sin_Theta, const Temporal& q) const {
+    const Vec2 b = polar_body_force(r, q);
+    const double alpha = q.g * r.h;
+    const double ca = std::cos(alpha), sa = std::sin(alpha);
+    const double c = cos_Theta * ca - sin_Theta * sa, s = sin_Theta * ca + cos_Theta * sa;  // cos, sin theta
+    return {b.x() * c - b.y() * s, b.x() * s + b.y() * c};
+  }
+
   Vec2 body_force(const Vec2& X, double t) const {
     const double R = X.norm();
-    const double Theta = std::atan2(X.y(), X.x());
-    const double gt = g(t), hR = h(R), hp = h_prime(R);
-    const double nu = p_.mu / p_.density;
-    const double b_r = -R * (g_dot(t) * hR) * (g_dot(t) * hR) + nu * R * (hp * gt) * (hp * gt);
-    const double b_t = R * g_ddot(t) * hR - nu * (3.0 * hp + R * h_second(R)) * gt;
-    const double theta = Theta + gt * hR;
-    const double c = std::cos(theta), s = std::sin(theta);
-    return {b_r * c - b_t * s, b_r * s + b_t * c};
+    return body_force(radial(R), X.x() / R, X.y() / R, temporal(t));
   }
 
  private:

@@ -30,21 +30,13 @@ const char* to_string(Scheme s) {
   return "?";
 }
 
-const char* to_string(DeformationUpdate u) {
-  switch (u) {
-    case DeformationUpdate::forward_euler: return "forward-euler";
-    case DeformationUpdate::midpoint: return "midpoint";
-  }
-  return "?";
-}
-
 double p_wave_modulus(const MaterialModel& m) {
   return std::visit([](const auto& material) { return material.p_wave_modulus(); }, m);
 }
 
 namespace {
 
-template <class Shape, class Material, DeformationUpdate U>
+template <class Shape, class Material>
 class ExplicitStepper final : public Stepper {
  public:
   ExplicitStepper(Model model, Scheme scheme, Material material,
@@ -94,19 +86,27 @@ class ExplicitStepper final : public Stepper {
     update_grid_motion(fields_, kick);
     apply_roller_walls(model_.grid, fields_);
     move_tracers(dt);
-    grid_to_particles<kVelocity | kPosition | kDeformation, Shape, U>(shape, fields_, P, dt, kick);
+    grid_to_particles<kVelocity | kPosition | kDeformation, Shape>(shape, fields_, P, dt, kick);
     update_stress(material_, P);
   }
 
   // Update stress first: F and stress from the grid velocity at t_n, then the
-  // forces of the new stress move the grid and the particles.
+  // forces of the new stress move the grid and the particles. All transfers of
+  // the step use the weights of the start of the step: the mass that divides
+  // the forces is the mass the velocities are read back with, which is what
+  // conserves momentum. CPDI domains therefore come from a copy of F_n.
   void step_usf(double t, double dt, double kick) {
     Particles& P = model_.particles;
-    const Shape shape = Shape::bind(model_.grid, P);
+    const Mat2* domain_deformation = nullptr;
+    if constexpr (Shape::reads_deformation_gradient) {
+      step_start_deformation_ = P.deformation_gradient;
+      domain_deformation = step_start_deformation_.data();
+    }
+    const Shape shape = Shape::bind(model_.grid, P, domain_deformation);
     particles_to_grid<kMass | kMomentum>(shape, P, buffers_, fields_);
     grid_velocity_from_momentum(fields_);
     apply_roller_walls(model_.grid, fields_);
-    grid_to_particles<kDeformation, Shape, U>(shape, fields_, P, dt, kick);
+    grid_to_particles<kDeformation, Shape>(shape, fields_, P, dt, kick);
     update_stress(material_, P);
     if (body_force_) {
       evaluate_body_force(t);
@@ -117,7 +117,7 @@ class ExplicitStepper final : public Stepper {
     update_grid_motion(fields_, kick);
     apply_roller_walls(model_.grid, fields_);
     move_tracers(dt);
-    grid_to_particles<kVelocity | kPosition, Shape, U>(shape, fields_, P, dt, kick);
+    grid_to_particles<kVelocity | kPosition, Shape>(shape, fields_, P, dt, kick);
   }
 
   // Modified USL: as USL, but the velocity gradient comes from the particle
@@ -129,11 +129,11 @@ class ExplicitStepper final : public Stepper {
     update_grid_motion(fields_, kick);
     apply_roller_walls(model_.grid, fields_);
     move_tracers(dt);
-    grid_to_particles<kVelocity | kPosition, Shape, U>(shape, fields_, P, dt, kick, next_position_.data());
+    grid_to_particles<kVelocity | kPosition, Shape>(shape, fields_, P, dt, kick, next_position_.data());
     particles_to_grid<kMomentum>(shape, P, buffers_, fields_);
     grid_velocity_from_momentum(fields_);
     apply_roller_walls(model_.grid, fields_);
-    grid_to_particles<kDeformation, Shape, U>(shape, fields_, P, dt, kick);
+    grid_to_particles<kDeformation, Shape>(shape, fields_, P, dt, kick);
     P.position.swap(next_position_);
     update_stress(material_, P);
   }
@@ -163,27 +163,17 @@ class ExplicitStepper final : public Stepper {
   std::shared_ptr<const BodyForce> body_force_;
   ScatterBuffers buffers_;
   std::vector<Vec2> next_position_;  // MUSL only: x_{n+1} while x_n still sets the weights
+  std::vector<Mat2> step_start_deformation_;  // USF with CPDI only: F_n, which sets the domains
 };
-
-template <class Shape, class Material>
-std::unique_ptr<Stepper> make_for_update(Model model, const SolverOptions& o, const Material& m,
-                                         std::shared_ptr<const BodyForce> body_force) {
-  switch (o.deformation_update) {
-    case DeformationUpdate::forward_euler:
-      return std::make_unique<ExplicitStepper<Shape, Material, DeformationUpdate::forward_euler>>(
-          std::move(model), o.scheme, m, std::move(body_force));
-    case DeformationUpdate::midpoint:
-      return std::make_unique<ExplicitStepper<Shape, Material, DeformationUpdate::midpoint>>(
-          std::move(model), o.scheme, m, std::move(body_force));
-  }
-  throw std::logic_error("unknown deformation update");
-}
 
 template <class Shape>
 std::unique_ptr<Stepper> make_for_shape(Model model, const SolverOptions& o, const MaterialModel& material,
                                         std::shared_ptr<const BodyForce> body_force) {
   return std::visit(
-      [&](const auto& m) { return make_for_update<Shape>(std::move(model), o, m, std::move(body_force)); },
+      [&](const auto& m) -> std::unique_ptr<Stepper> {
+        using Material = std::decay_t<decltype(m)>;
+        return std::make_unique<ExplicitStepper<Shape, Material>>(std::move(model), o.scheme, m, std::move(body_force));
+      },
       material);
 }
 

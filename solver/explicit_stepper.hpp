@@ -43,7 +43,7 @@ class Stepper {
 };
 
 // Checks the particles carry what the method needs, then picks the stepper
-// instantiation for (method, material, deformation update): the one dispatch.
+// instantiation for (method, material): the one dispatch.
 std::unique_ptr<Stepper> make_stepper(Model model, const SolverOptions& options,
                                       const MaterialModel& material,
                                       std::shared_ptr<const BodyForce> body_force);

@@ -20,7 +20,6 @@ enum class Scheme { usl, usf, musl };
 
 const char* to_string(Method m);
 const char* to_string(Scheme s);
-const char* to_string(DeformationUpdate u);
 
 using MaterialModel = std::variant<NeoHookean, MooneyRivlin>;
 double p_wave_modulus(const MaterialModel& m);
@@ -28,7 +27,6 @@ double p_wave_modulus(const MaterialModel& m);
 struct SolverOptions {
   Method method = Method::cpdi;
   Scheme scheme = Scheme::usl;
-  DeformationUpdate deformation_update = DeformationUpdate::forward_euler;
 };
 
 // A body force supplied by the scene, per unit mass. One call fills the whole

@@ -159,38 +159,22 @@ inline void apply_roller_walls(const GridGeometry& grid, GridFields& g) {
 
 // ---------------------------------------------------------------- grid to particle
 
-// How F advances over a step from the velocity gradient L (section 1.5.1).
-enum class DeformationUpdate {
-  forward_euler,  // Delta F = I + L dt, eq. 1.74 (first order)
-  midpoint,       // Delta F = (I - L dt/2)^-1 (I + L dt/2): second order, and an
-                  // exact rotation when L is skew (the Cayley form of eq. 1.78)
-};
-
-template <DeformationUpdate U>
-inline Mat2 deformation_increment(const Mat2& L, double dt) {
-  if constexpr (U == DeformationUpdate::forward_euler) {
-    return Mat2::Identity() + dt * L;
-  } else {
-    const Mat2 half = 0.5 * dt * L;
-    return inverse(Mat2::Identity() - half) * (Mat2::Identity() + half);
-  }
-}
-
 // What a grid-to-particle transfer updates.
 enum ParticleUpdate : unsigned {
   kVelocity = 1u,     // v_p += dt_kick sum_g S_gp a_g (eq. 1.76)
   kPosition = 2u,     // x_p += dt sum_g S_gp v_g^L (eq. 1.76)
-  kDeformation = 4u,  // L_p = sum_g v_g (x) G_gp (eq. 1.73); F_p <- Delta F F_p and
-                      // V_p = det(F_p) V_p0 (eqs. 1.74-1.75; the product of the
-                      // increments' determinants that eq. 1.75 accumulates, without
-                      // its round-off drift)
+  kDeformation = 4u,  // L_p = sum_g v_g (x) G_gp (eq. 1.73); F_p <- (I + dt L_p) F_p
+                      // (eq. 1.74) and V_p = det(F_p) V_p0 (eq. 1.75: the product of
+                      // the increments' determinants, without its round-off drift).
+                      // With positions moved by x += dt sum S v (eq. 1.76), I + dt L
+                      // is the exact gradient of that map, so F follows the particles.
 };
 
 // Every update reads the grid at the particle's position at the start of the
 // stage. New positions go to `position_out`, which may be P.position itself
 // (each particle reads its own position before writing it) or, when a later
 // stage still needs the old positions, another array.
-template <unsigned Updates, class Shape, DeformationUpdate U = DeformationUpdate::forward_euler>
+template <unsigned Updates, class Shape>
 void grid_to_particles(const Shape& shape, const GridFields& g, Particles& P, double dt, double kick,
                        Vec2* position_out = nullptr) {
   constexpr bool with_velocity = Updates & kVelocity;
@@ -213,7 +197,7 @@ void grid_to_particles(const Shape& shape, const GridFields& g, Particles& P, do
         if constexpr (with_deformation) L += g.velocity[i] * s.gradient[k].transpose();
       }
       if constexpr (with_deformation) {
-        P.deformation_gradient[p] = deformation_increment<U>(L, dt) * P.deformation_gradient[p];
+        P.deformation_gradient[p] = (Mat2::Identity() + dt * L) * P.deformation_gradient[p];
         P.volume[p] = determinant(P.deformation_gradient[p]) * P.reference_volume[p];
       }
       if constexpr (with_velocity) P.velocity[p] += kick * acceleration;

@@ -141,6 +141,17 @@ double Group::attribute_double(const std::string& name) const {
   return v;
 }
 
+std::vector<double> Group::attribute_doubles(const std::string& name) const {
+  const std::string what = path_ + "@" + name;
+  Handle attr(check(H5Aopen(id(), name.c_str(), H5P_DEFAULT), "H5Aopen", what), H5Aclose);
+  Handle space(check(H5Aget_space(attr.get()), "H5Aget_space", what), H5Sclose);
+  const hssize_t count = H5Sget_simple_extent_npoints(space.get());
+  if (count < 0) fail("H5Sget_simple_extent_npoints", what);
+  std::vector<double> values(static_cast<std::size_t>(count));
+  if (count > 0) check_status(H5Aread(attr.get(), H5T_NATIVE_DOUBLE, values.data()), "H5Aread", what);
+  return values;
+}
+
 std::int64_t Group::attribute_int(const std::string& name) const {
   const std::string what = path_ + "@" + name;
   Handle attr(check(H5Aopen(id(), name.c_str(), H5P_DEFAULT), "H5Aopen", what), H5Aclose);

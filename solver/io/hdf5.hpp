@@ -49,6 +49,7 @@ class Group {
   void write(const std::string& name, const std::vector<std::int64_t>& data, const std::vector<hsize_t>& dims);
 
   double attribute_double(const std::string& name) const;
+  std::vector<double> attribute_doubles(const std::string& name) const;
   std::int64_t attribute_int(const std::string& name) const;
   std::string attribute_string(const std::string& name) const;
   std::vector<double> read_doubles(const std::string& name, std::vector<hsize_t>* dims = nullptr) const;

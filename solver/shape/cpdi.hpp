@@ -29,8 +29,15 @@ struct CpdiShape {
   const Mat2* deformation_gradient;
   const Vec2* half_size;
 
-  static CpdiShape bind(const GridGeometry& grid, const Particles& particles) {
-    return {&grid, particles.position.data(), particles.deformation_gradient.data(),
+  static constexpr bool reads_deformation_gradient = true;
+
+  // The domains span F_p diag(l_p); `deformation_gradient` may point to a copy
+  // of F taken at the start of a step, so that every transfer of the step uses
+  // the same domains.
+  static CpdiShape bind(const GridGeometry& grid, const Particles& particles,
+                        const Mat2* deformation_gradient = nullptr) {
+    return {&grid, particles.position.data(),
+            deformation_gradient ? deformation_gradient : particles.deformation_gradient.data(),
             particles.half_size.data()};
   }
 
@@ -48,15 +55,16 @@ struct CpdiShape {
 
   void evaluate(std::size_t p, Stencil<stencil_size>& st) const {
     const Mat2 s = domain(p);
-    const Mat2 s_inv_t = inverse(s).transpose();
+    // (1/4) s_p^-T written out: s^-T = [[s11, -s10], [-s01, s00]] / det s.
+    const double quarter_inv_det = 0.25 / determinant(s);
     for (int c = 0; c < 4; ++c) {
+      const double xi = corner_xi[c], eta = corner_eta[c];
+      const Vec2 corner_gradient = quarter_inv_det * Vec2(s(1, 1) * xi - s(1, 0) * eta, s(0, 0) * eta - s(0, 1) * xi);
       int* node = st.node + 4 * c;
       double* w = st.weight + 4 * c;
-      Vec2* g = st.gradient + 4 * c;
-      bilinear_cell(*grid, corner(p, s, c), node, w, g);
-      const Vec2 corner_gradient = 0.25 * (s_inv_t * Vec2(corner_xi[c], corner_eta[c]));
+      bilinear_cell_weights(*grid, corner(p, s, c), node, w);
       for (int k = 0; k < 4; ++k) {
-        g[k] = corner_gradient * w[k];
+        st.gradient[4 * c + k] = corner_gradient * w[k];
         w[k] *= 0.25;
       }
     }

@@ -40,7 +40,9 @@ struct GimpShape {
   const Vec2* position;
   const Vec2* half_size;
 
-  static GimpShape bind(const GridGeometry& grid, const Particles& particles) {
+  static constexpr bool reads_deformation_gradient = false;
+
+  static GimpShape bind(const GridGeometry& grid, const Particles& particles, const Mat2* = nullptr) {
     return {&grid, particles.position.data(), particles.half_size.data()};
   }
 

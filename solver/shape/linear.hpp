@@ -34,6 +34,26 @@ inline void bilinear_cell(const GridGeometry& grid, const Vec2& x, int* node, do
   gradient[3] = Vec2(fy, fx) * inv_h;
 }
 
+// Bilinear hat weights alone, for callers that form their own gradients. The
+// point must lie inside the grid (the health scan guarantees it before every
+// step), so truncation toward zero is the floor.
+inline void bilinear_cell_weights(const GridGeometry& grid, const Vec2& x, int* node, double* weight) {
+  const Vec2 xi = grid_coordinate(grid, x);
+  const int i = static_cast<int>(xi.x());
+  const int j = static_cast<int>(xi.y());
+  const double fx = xi.x() - i, fy = xi.y() - j;
+  const double gx = 1.0 - fx, gy = 1.0 - fy;
+  const int n00 = grid.node(i, j);
+  node[0] = n00;
+  node[1] = n00 + 1;
+  node[2] = n00 + grid.nodes_x();
+  node[3] = n00 + grid.nodes_x() + 1;
+  weight[0] = gx * gy;
+  weight[1] = fx * gy;
+  weight[2] = gx * fy;
+  weight[3] = fx * fy;
+}
+
 struct LinearShape {
   static constexpr int stencil_size = 4;
   static constexpr const char* name = "linear";
@@ -41,7 +61,9 @@ struct LinearShape {
   const GridGeometry* grid;
   const Vec2* position;
 
-  static LinearShape bind(const GridGeometry& grid, const Particles& particles) {
+  static constexpr bool reads_deformation_gradient = false;
+
+  static LinearShape bind(const GridGeometry& grid, const Particles& particles, const Mat2* = nullptr) {
     return {&grid, particles.position.data()};
   }
 

@@ -157,7 +157,13 @@ void Config::set_from_text(const std::string& assignment) {
     throw ConfigError(fmt::format("--set {}: expected key=value", assignment));
   const std::string key = trim(assignment.substr(0, eq));
   const std::string text = trim(assignment.substr(eq + 1));
-  const KeySpec& s = spec(key);
+  const KeySpec* found = nullptr;
+  try {
+    found = &spec(key);
+  } catch (const ConfigError& e) {
+    throw ConfigError(fmt::format("--set {}: {}", assignment, e.what()));
+  }
+  const KeySpec& s = *found;
   const Origin origin{"--set " + assignment};
   auto bad = [&]() {
     throw ConfigError(fmt::format("--set {}: key '{}' must be {}", assignment, key, s.describe_range()));

@@ -87,6 +87,7 @@ void write_results_file(const std::string& path, const RunRequest& request, cons
   root.set_attribute("dt_min", o.dt_min);
   root.set_attribute("dt_max", o.dt_max);
   scene.write_results(root);
+  write_errors(root, scene.errors(), scene.error_description());
   file.flush();
 }
 
@@ -175,7 +176,7 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
     fmt::print(out, "{} {}: FAILED at t = {:.4g} s, step {}, particle {}: {} ({})\n", config.scene(),
                config.text("method"), o.failure_time, o.failure_step, o.failure_particle, o.failure_reason,
                o.failure_detail);
-  scene->print_summary(out);
+  print_error_table(out, scene->errors());
   fmt::print(out, "results: {}\n", output);
   return o.completed ? 0 : 1;
 }

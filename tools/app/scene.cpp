@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <ostream>
+
+#include <fmt/ostream.h>
 
 #include <fmt/format.h>
 
@@ -31,9 +34,6 @@ std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_
        -inf, inf, false, false, {"linear", "gimp", "cpdi"}},
       {"scheme", KeyKind::text, std::string("usl"), "stress update: usl (update stress last), usf (first), musl (modified USL)",
        -inf, inf, false, false, {"usl", "usf", "musl"}},
-      {"deformation_update", KeyKind::text, std::string("forward-euler"),
-       "F increment: forward-euler (I + L dt, eq. 1.74) or midpoint ((I - L dt/2)^-1 (I + L dt/2))", -inf, inf,
-       false, false, {"forward-euler", "midpoint"}},
       {"time_integration", KeyKind::text, std::string("central-difference"),
        "central-difference (velocities at half steps, second order) or symplectic-euler (velocities at whole "
        "steps, first order); both use eqs. 1.72 and 1.76",
@@ -58,8 +58,6 @@ SolverOptions solver_options(const Config& c) {
   o.method = m == "linear" ? Method::linear : m == "gimp" ? Method::gimp : Method::cpdi;
   const std::string& s = c.text("scheme");
   o.scheme = s == "usf" ? Scheme::usf : s == "musl" ? Scheme::musl : Scheme::usl;
-  o.deformation_update =
-      c.text("deformation_update") == "midpoint" ? DeformationUpdate::midpoint : DeformationUpdate::forward_euler;
   return o;
 }
 
@@ -77,6 +75,35 @@ TimeLoopOptions time_loop_options(const Config& c) {
     if (t < o.end_time) o.output_times.push_back(t);
   o.output_times.push_back(o.end_time);
   return o;
+}
+
+const std::vector<double>& ErrorTable::column(const std::string& name) const {
+  for (const auto& [n, values] : columns)
+    if (n == name) return values;
+  throw std::out_of_range("no error column '" + name + "'");
+}
+
+std::vector<double>& ErrorTable::add_column(const std::string& name) {
+  columns.emplace_back(name, std::vector<double>{});
+  return columns.back().second;
+}
+
+void print_error_table(std::ostream& out, const ErrorTable& errors) {
+  fmt::print(out, "{:>8}", "t [s]");
+  for (const auto& [name, values] : errors.columns) fmt::print(out, " {:>14}", name);
+  fmt::print(out, "\n");
+  for (std::size_t k = 0; k < errors.time.size(); ++k) {
+    fmt::print(out, "{:>8.4g}", errors.time[k]);
+    for (const auto& [name, values] : errors.columns) fmt::print(out, " {:>14.4e}", values[k]);
+    fmt::print(out, "\n");
+  }
+}
+
+void write_errors(h5::Group& root, const ErrorTable& errors, const std::string& description) {
+  h5::Group e = root.create_group("errors");
+  e.set_attribute("description", description);
+  e.write("time", errors.time, {errors.time.size()});
+  for (const auto& [name, values] : errors.columns) e.write(name, values, {values.size()});
 }
 
 void write_particles(h5::Group& root, const Particles& P) {

@@ -16,6 +16,15 @@
 
 namespace mpmvv::app {
 
+// Error norms per output time, one named column per norm.
+struct ErrorTable {
+  std::vector<double> time;
+  std::vector<std::pair<std::string, std::vector<double>>> columns;
+
+  const std::vector<double>& column(const std::string& name) const;
+  std::vector<double>& add_column(const std::string& name);
+};
+
 // One configured case of a scene, ready to run.
 class SceneCase {
  public:
@@ -25,10 +34,11 @@ class SceneCase {
   // Cell size, for the results file.
   virtual double cell_size() const = 0;
   virtual std::size_t particle_count() const = 0;
-  // Writes particles, probes and errors under `root`.
+  // Writes particles and probes under `root` (the errors are written from errors()).
   virtual void write_results(h5::Group& root) const = 0;
-  // The error table a person reads at the end of a run.
-  virtual void print_summary(std::ostream& out) const = 0;
+  virtual const ErrorTable& errors() const = 0;
+  // What the error columns mean, stored with them.
+  virtual std::string error_description() const = 0;
 };
 
 struct SceneType {
@@ -49,6 +59,12 @@ std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_
 SolverOptions solver_options(const Config& config);
 // The output times that lie in (0, end_time], with end_time always last.
 TimeLoopOptions time_loop_options(const Config& config);
+
+// The error table a person reads at the end of a run.
+void print_error_table(std::ostream& out, const ErrorTable& errors);
+
+// Writes /errors: time and one dataset per column.
+void write_errors(h5::Group& root, const ErrorTable& errors, const std::string& description);
 
 // Writes the particle arrays every results file carries.
 void write_particles(h5::Group& root, const Particles& particles);

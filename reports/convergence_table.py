@@ -1,0 +1,68 @@
+#!/usr/bin/python3
+"""Convergence table of ring results files: the L1 error of eq. 3.1
+(000_1dbcb8acb6dddab9.txt) on each probe line and the volume-weighted particle
+L1 at every output time, against the cell size h, with the observed order
+p = log(E_coarse / E_fine) / log(h_coarse / h_fine) between consecutive meshes.
+
+Usage: /usr/bin/python3 reports/convergence_table.py RESULTS.h5 [RESULTS.h5 ...]
+"""
+import math
+import sys
+
+import h5py
+
+
+def read_case(path):
+    with h5py.File(path, "r") as f:
+        errors = f["errors"]
+        return {
+            "path": path,
+            "h": float(f.attrs["h"]),
+            "cells": int(f.attrs["cells"]),
+            "method": f.attrs["method"],
+            "status": f.attrs["status"],
+            "time_reached": float(f.attrs["time_reached"]),
+            "failure_reason": f.attrs["failure_reason"],
+            "wall": float(f.attrs["wall_time_s"]),
+            "time": list(errors["time"][:]),
+            "norms": {
+                "L1 Theta=0": list(errors["L1_theta0"][:]),
+                "L1 +45": list(errors["L1_theta_plus45"][:]),
+                "L1 -45": list(errors["L1_theta_minus45"][:]),
+                "particle L1": list(errors["particle_L1"][:]),
+            },
+        }
+
+
+def observed_order(e_coarse, e_fine, h_coarse, h_fine):
+    if e_coarse <= 0 or e_fine <= 0:
+        return float("nan")
+    return math.log(e_coarse / e_fine) / math.log(h_coarse / h_fine)
+
+
+def main(paths):
+    if not paths:
+        print(__doc__.strip(), file=sys.stderr)
+        return 2
+    cases = sorted((read_case(p) for p in paths), key=lambda c: -c["h"])
+    print(f"{'cells':>6} {'h [m]':>9} {'method':>7} {'status':>10} {'reached':>8} {'wall [s]':>9}")
+    for c in cases:
+        status = c["status"] if c["status"] == "completed" else f"failed ({c['failure_reason']})"
+        print(f"{c['cells']:>6} {c['h']:>9.4g} {c['method']:>7} {status:>10} {c['time_reached']:>8.4g} {c['wall']:>9.3g}")
+    times = cases[0]["time"]
+    for norm in cases[0]["norms"]:
+        print(f"\n{norm} (rad for probe lines, m for particles); order p between consecutive meshes")
+        header = f"{'t [s]':>7}" + "".join(f" {'h=' + format(c['h'], '.4g'):>12}" for c in cases)
+        header += "".join(f" {'p':>6}" for _ in cases[1:])
+        print(header)
+        for k, t in enumerate(times):
+            values = [c["norms"][norm][k] if k < len(c["time"]) else float("nan") for c in cases]
+            row = f"{t:>7.3g}" + "".join(f" {v:>12.4e}" for v in values)
+            for a, b in zip(range(len(cases) - 1), range(1, len(cases))):
+                row += f" {observed_order(values[a], values[b], cases[a]['h'], cases[b]['h']):>6.2f}"
+            print(row)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

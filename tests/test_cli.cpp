@@ -1,0 +1,140 @@
+// The built `mpmvv` command line: bad input exits with status 2 and one line
+// on stderr naming what is wrong, writes no results file, and help exits 0.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Outcome {
+  int status;
+  std::string out, err;
+};
+
+std::string read_file(const fs::path& path) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+// `text` in single quotes, for the shell.
+std::string quoted(const std::string& text) {
+  std::string q = "'";
+  q += text;
+  q += "'";
+  return q;
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    directory_ = fs::temp_directory_path() /
+                 ("mpmvv_test_cli_" + std::to_string(::getpid()) + "_" +
+                  ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(directory_);
+  }
+  void TearDown() override { fs::remove_all(directory_); }
+
+  // Runs `mpmvv <arguments>` with stdout and stderr captured in files.
+  Outcome mpmvv(const std::string& arguments) const {
+    const fs::path out = directory_ / "stdout.txt", err = directory_ / "stderr.txt";
+    const std::string command =
+        quoted(MPMVV_BINARY) + " " + arguments + " >" + quoted(out.string()) + " 2>" + quoted(err.string()) + " </dev/null";
+    const int raw = std::system(command.c_str());
+    EXPECT_TRUE(WIFEXITED(raw)) << command;
+    return {WEXITSTATUS(raw), read_file(out), read_file(err)};
+  }
+
+  std::string ring_scene() const { return quoted(std::string(MPMVV_SOURCE_DIR) + "/suites/scenes/ring.toml"); }
+  std::string results() const { return quoted((directory_ / "x.h5").string()); }
+  bool results_written() const { return fs::exists(directory_ / "x.h5") || fs::exists(directory_ / "x.h5.partial"); }
+
+  fs::path directory_;
+};
+
+// An unknown override key: exit 2, exactly one line on stderr naming it,
+// nothing on stdout, no results file.
+TEST_F(Cli, UnknownOverrideKeyExitsTwoWithOneLine) {
+  const Outcome o = mpmvv("run " + ring_scene() + " --set nokey=1 -q -o " + results());
+  EXPECT_EQ(o.status, 2);
+  const std::vector<std::string> lines = lines_of(o.err);
+  ASSERT_EQ(lines.size(), 1u) << o.err;
+  EXPECT_NE(lines[0].find("'nokey'"), std::string::npos) << lines[0];
+  EXPECT_EQ(o.out, "");
+  EXPECT_FALSE(results_written());
+}
+
+// A value of the wrong kind: exit 2, one line naming the key and its range.
+TEST_F(Cli, BadOverrideValueExitsTwo) {
+  const Outcome o = mpmvv("run " + ring_scene() + " --set cells=abc -q -o " + results());
+  EXPECT_EQ(o.status, 2);
+  const std::vector<std::string> lines = lines_of(o.err);
+  ASSERT_EQ(lines.size(), 1u) << o.err;
+  EXPECT_NE(lines[0].find("'cells'"), std::string::npos) << lines[0];
+  EXPECT_NE(lines[0].find("[4, 20000]"), std::string::npos) << lines[0];
+  EXPECT_FALSE(results_written());
+}
+
+// A scene file that does not exist: exit 2, one line naming it.
+TEST_F(Cli, MissingSceneFileExitsTwo) {
+  const std::string missing = (directory_ / "absent.toml").string();
+  const Outcome o = mpmvv("run " + quoted(missing) + " -q -o " + results());
+  EXPECT_EQ(o.status, 2);
+  const std::vector<std::string> lines = lines_of(o.err);
+  ASSERT_EQ(lines.size(), 1u) << o.err;
+  EXPECT_NE(lines[0].find(missing), std::string::npos) << lines[0];
+  EXPECT_FALSE(results_written());
+}
+
+// A results path that is not .h5 is bad input too, refused before the run.
+TEST_F(Cli, ResultsFileMustEndInH5) {
+  const Outcome o = mpmvv("run " + ring_scene() + " -q -o " + quoted((directory_ / "x.txt").string()));
+  EXPECT_EQ(o.status, 2);
+  EXPECT_NE(o.err.find(".h5"), std::string::npos) << o.err;
+  EXPECT_FALSE(fs::exists(directory_ / "x.txt"));
+}
+
+// No subcommand, or `run` without a scene: a usage error, exit 2.
+TEST_F(Cli, UsageErrorsExitTwo) {
+  EXPECT_EQ(mpmvv("").status, 2);
+  EXPECT_EQ(mpmvv("run").status, 2);
+  EXPECT_EQ(mpmvv("run " + ring_scene() + " --no-such-flag").status, 2);
+}
+
+// Help exits 0; `run --help` documents --set.
+TEST_F(Cli, HelpExitsZero) {
+  const Outcome top = mpmvv("--help");
+  EXPECT_EQ(top.status, 0);
+  EXPECT_NE(top.out.find("run"), std::string::npos) << top.out;
+  const Outcome run = mpmvv("run --help");
+  EXPECT_EQ(run.status, 0);
+  EXPECT_NE(run.out.find("--set"), std::string::npos) << run.out;
+}
+
+// --describe prints every key with its value and origin and runs nothing.
+TEST_F(Cli, DescribeListsResolvedKeys) {
+  const Outcome o = mpmvv("run " + ring_scene() + " --set cells=40 --describe");
+  EXPECT_EQ(o.status, 0) << o.err;
+  EXPECT_NE(o.out.find("cells = 40"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("--set cells=40"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("output_times = "), std::string::npos) << o.out;
+}
+
+}  // namespace

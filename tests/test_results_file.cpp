@@ -1,0 +1,115 @@
+// The results file written by `mpmvv run` holds what reports/results-format.md
+// documents, for a completed run and for a run the solver stopped.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include "solver/io/hdf5.hpp"
+#include "tools/app/scene.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+int run_mpmvv(const std::string& args) {
+  const std::string command = std::string(MPMVV_BINARY) + " run " + MPMVV_SOURCE_DIR +
+                              "/suites/scenes/ring.toml -q " + args + " > /dev/null 2>&1";
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+fs::path scratch(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / "mpmvv-results-test";
+  fs::create_directories(dir);
+  const fs::path p = dir / name;
+  fs::remove(p);
+  return p;
+}
+
+std::vector<hsize_t> dims_of(const mpmvv::h5::Group& g, const std::string& name) {
+  std::vector<hsize_t> dims;
+  g.read_doubles(name, &dims);
+  return dims;
+}
+
+}  // namespace
+
+// A completed run stores status, timings, every scene key, particles, probes and errors.
+TEST(ResultsFile, CompletedRunHoldsTheDocumentedLayout) {
+  const fs::path out = scratch("completed.h5");
+  ASSERT_EQ(run_mpmvv("--set cells=32 --set end_time=0.25 --set output_times=0.1 -o " + out.string()), 0);
+  ASSERT_TRUE(fs::exists(out));
+  EXPECT_FALSE(fs::exists(out.string() + ".partial"));
+  const mpmvv::h5::File file = mpmvv::h5::File::open_read(out.string());
+  const mpmvv::h5::Group root = file.root();
+
+  EXPECT_EQ(root.attribute_string("status"), "completed");
+  EXPECT_EQ(root.attribute_string("failure_reason"), "");
+  EXPECT_GT(root.attribute_int("steps"), 0);
+  EXPECT_GT(root.attribute_double("wall_time_s"), 0.0);
+  EXPECT_GT(root.attribute_double("forcing_time_s"), 0.0);
+  EXPECT_DOUBLE_EQ(root.attribute_double("h"), 3.0 / 32.0);
+  EXPECT_GT(root.attribute_double("dt"), 0.0);
+  EXPECT_EQ(root.attribute_string("method"), "cpdi");
+  EXPECT_EQ(root.attribute_int("particles_per_direction"), 2);
+  EXPECT_EQ(root.attribute_int("cells"), 32);
+  EXPECT_NE(root.attribute_string("configuration").find("cells = 32"), std::string::npos);
+  EXPECT_NE(root.attribute_string("version").find("mpmvv"), std::string::npos);
+  // Every scene key is an attribute of its own.
+  for (const mpmvv::app::KeySpec& key : mpmvv::app::find_scene_type("ring")->keys())
+    EXPECT_GE(H5Aexists(root.id(), key.name.c_str()), 1) << key.name;
+
+  const std::int64_t n = root.attribute_int("particle_count");
+  const mpmvv::h5::Group particles = root.open_group("particles");
+  EXPECT_EQ(dims_of(particles, "reference_position"), (std::vector<hsize_t>{hsize_t(n), 2}));
+  EXPECT_EQ(dims_of(particles, "position"), (std::vector<hsize_t>{hsize_t(n), 2}));
+  EXPECT_EQ(dims_of(particles, "volume"), (std::vector<hsize_t>{hsize_t(n)}));
+
+  const mpmvv::h5::Group probes = root.open_group("probes");
+  for (const char* line : {"theta0", "theta_plus45", "theta_minus45"}) {
+    const mpmvv::h5::Group g = probes.open_group(line);
+    EXPECT_EQ(dims_of(g, "reference_radius"), (std::vector<hsize_t>{51})) << line;
+    EXPECT_EQ(dims_of(g, "angular_displacement"), (std::vector<hsize_t>{2, 51})) << line;
+    EXPECT_EQ(dims_of(g, "exact_angular_displacement"), (std::vector<hsize_t>{2, 51})) << line;
+  }
+  const mpmvv::h5::Group point = probes.open_group("point_R1");
+  EXPECT_EQ(dims_of(point, "time"), (std::vector<hsize_t>{hsize_t(root.attribute_int("steps"))}));
+
+  const mpmvv::h5::Group errors = root.open_group("errors");
+  EXPECT_EQ(errors.read_doubles("time"), (std::vector<double>{0.1, 0.25}));
+  for (const char* name : {"L1_theta0", "L1_theta_plus45", "L1_theta_minus45", "particle_L1", "particle_L2",
+                           "particle_Linf"}) {
+    const std::vector<double> values = errors.read_doubles(name);
+    ASSERT_EQ(values.size(), 2u) << name;
+    EXPECT_GT(values[1], 0.0) << name;
+  }
+}
+
+// A run the solver stops is exit status 1 with its reason, time, step and
+// particle recorded, and the rows of every output time it reached kept.
+TEST(ResultsFile, FailedRunRecordsWhyWhenAndWhere) {
+  const fs::path out = scratch("failed.h5");
+  // Linear MPM at A = 3 on 32 cells: measured to stop with NaN between t = 0.1 and 1.
+  ASSERT_EQ(run_mpmvv("--set cells=32 --set amplitude=3 --set method=linear -o " + out.string()), 1);
+  const mpmvv::h5::File file = mpmvv::h5::File::open_read(out.string());
+  const mpmvv::h5::Group root = file.root();
+  EXPECT_EQ(root.attribute_string("status"), "failed");
+  EXPECT_FALSE(root.attribute_string("failure_reason").empty());
+  EXPECT_FALSE(root.attribute_string("failure_detail").empty());
+  const double failure_time = root.attribute_double("failure_time");
+  EXPECT_GT(failure_time, 0.0);
+  EXPECT_LT(failure_time, 1.0);
+  EXPECT_DOUBLE_EQ(root.attribute_double("time_reached"), failure_time);
+  EXPECT_EQ(root.attribute_int("failure_step"), root.attribute_int("steps"));
+  EXPECT_GE(root.attribute_int("failure_particle"), 0);
+  EXPECT_LT(root.attribute_int("failure_particle"), root.attribute_int("particle_count"));
+  std::vector<double> reached;
+  for (double t : root.attribute_doubles("output_times"))
+    if (t < failure_time) reached.push_back(t);
+  ASSERT_FALSE(reached.empty());
+  EXPECT_EQ(root.open_group("errors").read_doubles("time"), reached);
+}

@@ -1,0 +1,555 @@
+// The explicit MPM step and the time loop on small models built by hand
+// (002_c3305cb8b1bc1490.txt section 1.5): momentum conservation, a rigid
+// rotation, failures reported as data, repeatable threads, and a time loop
+// that lands on its output times within the CFL step.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <numbers>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "solver/explicit_stepper.hpp"
+#include "solver/parallel.hpp"
+#include "solver/shape/cpdi.hpp"
+#include "solver/time_loop.hpp"
+
+namespace {
+
+using mpmvv::Mat2;
+using mpmvv::MaterialModel;
+using mpmvv::Method;
+using mpmvv::Model;
+using mpmvv::NeoHookean;
+using mpmvv::Particles;
+using mpmvv::Scheme;
+using mpmvv::SolverOptions;
+using mpmvv::Stepper;
+using mpmvv::Vec2;
+
+// The report's neo-Hookean solid (000_1dbcb8acb6dddab9.txt eq. 2.2).
+const NeoHookean kSolid{577.0, 385.0};
+constexpr double kDensity = 1000.0;  // rho_0 [kg/m^3]
+
+const Method kMethods[] = {Method::linear, Method::gimp, Method::cpdi};
+const Scheme kSchemes[] = {Scheme::usl, Scheme::usf, Scheme::musl};
+
+std::string scientific(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3e", x);
+  return text;
+}
+
+std::string label(Method m, Scheme s) { return std::string(to_string(m)) + "/" + to_string(s); }
+
+// A disk of radius 0.8 m centred on a square domain [-2, 2]^2 of `cells`
+// cells per side, seeded on a lattice of two particles per cell per
+// direction, at rest and unstressed.
+Model disk_model(Method method, int cells = 32) {
+  Model model;
+  model.grid.origin = Vec2(-2.0, -2.0);
+  model.grid.cells_x = model.grid.cells_y = cells;
+  model.grid.h = 4.0 / cells;
+  const double spacing = 0.5 * model.grid.h;
+  const double reference_volume = spacing * spacing;
+  std::vector<Vec2> lattice;
+  for (int j = 0; j < 2 * cells; ++j)
+    for (int i = 0; i < 2 * cells; ++i) {
+      const Vec2 x = model.grid.origin + spacing * Vec2(i + 0.5, j + 0.5);
+      if (x.norm() < 0.8) lattice.push_back(x);
+    }
+  Particles& P = model.particles;
+  P.resize(lattice.size());
+  for (std::size_t p = 0; p < lattice.size(); ++p) {
+    P.position[p] = P.reference_position[p] = lattice[p];
+    P.mass[p] = kDensity * reference_volume;
+    P.volume[p] = P.reference_volume[p] = reference_volume;
+  }
+  if (method != Method::linear) P.half_size.assign(lattice.size(), Vec2(0.5 * spacing, 0.5 * spacing));
+  return model;
+}
+
+// One more particle at x, like the disk's, appended to the model.
+void add_particle(Model& model, Method method, const Vec2& x) {
+  Particles& P = model.particles;
+  const double spacing = 0.5 * model.grid.h;
+  P.position.push_back(x);
+  P.reference_position.push_back(x);
+  P.velocity.push_back(Vec2::Zero());
+  P.deformation_gradient.push_back(Mat2::Identity());
+  P.stress.push_back(Mat2::Zero());
+  P.mass.push_back(kDensity * spacing * spacing);
+  P.volume.push_back(spacing * spacing);
+  P.reference_volume.push_back(spacing * spacing);
+  if (method != Method::linear) P.half_size.push_back(Vec2(0.5 * spacing, 0.5 * spacing));
+}
+
+double wave_speed() { return std::sqrt(kSolid.p_wave_modulus() / kDensity); }
+
+// dt = 0.3 h / c, well inside the CFL limit of an undeformed grid.
+double stable_step(const Model& model) { return 0.3 * model.grid.h / wave_speed(); }
+
+// Central-difference kicks: dt/2 on the first step, dt after.
+void advance(Stepper& stepper, int steps, double dt) {
+  double t = 0.0;
+  for (int k = 0; k < steps; ++k) {
+    stepper.step(t, dt, k == 0 ? 0.5 * dt : dt);
+    t += dt;
+  }
+}
+
+Vec2 total_momentum(const Particles& P) {
+  Vec2 sum = Vec2::Zero();
+  for (std::size_t p = 0; p < P.size(); ++p) sum += P.mass[p] * P.velocity[p];
+  return sum;
+}
+
+double total_momentum_magnitude(const Particles& P) {
+  double sum = 0.0;
+  for (std::size_t p = 0; p < P.size(); ++p) sum += P.mass[p] * P.velocity[p].norm();
+  return sum;
+}
+
+// ---------------------------------------------------------------- momentum
+
+// sum_p m_p v_p after 20 steps without body force, relative to sum_p m_p |v_p|.
+// The disk shears and stretches everywhere and drifts so the total is not zero.
+double momentum_change(Method method, Scheme scheme) {
+  Model model = disk_model(method);
+  for (std::size_t p = 0; p < model.particles.size(); ++p) {
+    const Vec2 x = model.particles.position[p];
+    model.particles.velocity[p] = Vec2(0.1 * std::sin(x.y()) + 0.02, 0.05 * x.x() - 0.01);
+  }
+  const Vec2 before = total_momentum(model.particles);
+  const double scale = total_momentum_magnitude(model.particles);
+  const double dt = stable_step(model);
+  auto stepper = mpmvv::make_stepper(std::move(model), SolverOptions{method, scheme},
+                                     MaterialModel{kSolid}, nullptr);
+  advance(*stepper, 20, dt);
+  const Particles& P = stepper->model().particles;
+  // The body deforms, so conservation is not the trivial result of rest.
+  double largest_stress = 0.0;
+  for (const Mat2& s : P.stress) largest_stress = std::max(largest_stress, s.norm());
+  EXPECT_GT(largest_stress, 1e-3 * kSolid.mu);
+  return (total_momentum(P) - before).norm() / scale;
+}
+
+// With no body force and the body away from the walls, sum_p m_p v_p does not
+// change: the internal forces sum to zero over the nodes (the gradients sum
+// to zero, eq. 1.70) and the velocity update uses the weights that made the
+// node masses. Every method and scheme but CPDI with USF (disabled below).
+TEST(Solver, MomentumIsConservedWithoutExternalForce) {
+  for (Method method : kMethods)
+    for (Scheme scheme : kSchemes) {
+      if (method == Method::cpdi && scheme == Scheme::usf) continue;
+      SCOPED_TRACE(label(method, scheme));
+      const double change = momentum_change(method, scheme);
+      RecordProperty("momentum_change_" + label(method, scheme), scientific(change));
+      // Measured 6.3e-16 to 1.3e-15 relative: round-off of the node sums.
+      // 1e-12 leaves a wide margin and still catches a lost force.
+      EXPECT_LT(change, 1e-12);
+    }
+}
+
+// CPDI with USF conserves momentum: the step maps mass and momentum with the
+// domains of F_n, advances F, and must still map forces and read velocities
+// back with the domains of F_n (it keeps a copy), or sum_p m_p S_gp no longer
+// equals m_g. Before that copy the change was 6.9e-7 relative after 20 steps;
+// with it, round-off like every other method and scheme.
+TEST(Solver, CpdiUsfConservesMomentum) {
+  EXPECT_LT(momentum_change(Method::cpdi, Scheme::usf), 1e-12);
+}
+
+// ---------------------------------------------------------------- rigid rotation
+
+constexpr double kSpin = 0.5;  // omega [rad/s]
+
+// The centripetal force per unit mass -omega^2 x that makes a stress-free
+// rigid rotation an exact solution of the balance of momentum.
+class CentripetalForce final : public mpmvv::BodyForce {
+ public:
+  void evaluate(double, const Particles& P, std::vector<Vec2>& b) const override {
+    for (std::size_t p = 0; p < P.size(); ++p) b[p] = -kSpin * kSpin * P.position[p];
+  }
+};
+
+struct RotationResult {
+  double volume_change;        // (sum V_p - sum V_p0) / sum V_p0
+  double largest_stress;       // max_p |sigma_p| / mu
+  double interior_stress;      // the same over particles with reference radius < 0.5 m
+  double interior_mean_J;      // mean J - 1 over those particles
+  double mean_angle;           // mean angle turned [rad]
+};
+
+// A quarter turn of the disk spinning at omega under the centripetal force.
+RotationResult quarter_turn(Method method, Scheme scheme, const NeoHookean& solid,
+                            int cells = 32) {
+  Model model = disk_model(method, cells);
+  for (std::size_t p = 0; p < model.particles.size(); ++p) {
+    const Vec2 x = model.particles.position[p];
+    model.particles.velocity[p] = kSpin * Vec2(-x.y(), x.x());
+  }
+  const double duration = 0.5 * std::numbers::pi / kSpin;
+  const int steps = int(std::ceil(duration / stable_step(model)));
+  auto stepper = mpmvv::make_stepper(std::move(model), SolverOptions{method, scheme}, MaterialModel{solid},
+                                     std::make_shared<CentripetalForce>());
+  advance(*stepper, steps, duration / steps);
+
+  const Particles& P = stepper->model().particles;
+  RotationResult r{0.0, 0.0, 0.0, 0.0, 0.0};
+  double volume = 0.0, reference_volume = 0.0;
+  int interior = 0;
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    volume += P.volume[p];
+    reference_volume += P.reference_volume[p];
+    const double stress = P.stress[p].norm() / kSolid.mu;
+    r.largest_stress = std::max(r.largest_stress, stress);
+    const Vec2 X = P.reference_position[p], x = P.position[p];
+    r.mean_angle += std::atan2(X.x() * x.y() - X.y() * x.x(), X.dot(x)) / double(P.size());
+    if (X.norm() < 0.5) {
+      ++interior;
+      r.interior_stress = std::max(r.interior_stress, stress);
+      r.interior_mean_J += mpmvv::determinant(P.deformation_gradient[p]) - 1.0;
+    }
+  }
+  r.volume_change = volume / reference_volume - 1.0;
+  r.interior_mean_J /= interior;
+  return r;
+}
+
+// A material without stiffness: the particles move under the centripetal
+// force alone, and F only records their motion.
+const NeoHookean kNoStiffness{0.0, 0.0};
+
+// With update-stress-last (USL, MUSL) the forward-Euler increment
+// I + dt L (eq. 1.74) is the exact gradient of the position update (eq. 1.76),
+// so a stress-free body turning a quarter turn keeps J = 1 in its interior;
+// the disk turns within 2% of pi/2 (the lag is the smoothing of the grid
+// velocity).
+TEST(RigidRotation, ForwardEulerIncrementFollowsTheParticleMotion) {
+  for (Method method : kMethods)
+    for (Scheme scheme : {Scheme::usl, Scheme::musl}) {
+      SCOPED_TRACE(label(method, scheme));
+      const RotationResult r = quarter_turn(method, scheme, kNoStiffness);
+      RecordProperty("interior_mean_J_minus_1_" + label(method, scheme), scientific(r.interior_mean_J));
+      // Measured +7.9e-5 (linear), +8.3e-5 (gimp), +1.6e-3 (cpdi) under USL and
+      // +9.4e-5, +1.1e-4, +1.7e-3 under MUSL. (A Cayley "midpoint" increment
+      // applied to this L drifts to -2.5e-2: it is not the gradient of the
+      // position update, which is why the solver has only eq. 1.74.)
+      EXPECT_LT(std::abs(r.interior_mean_J), 5e-3);
+      // Measured 1.5528-1.5577 rad against pi/2 = 1.5708: a lag of 0.8-1.1%.
+      EXPECT_NEAR(r.mean_angle, 0.5 * std::numbers::pi, 0.02 * 0.5 * std::numbers::pi);
+    }
+}
+
+// An elastic disk in rigid rotation is exactly stress-free and keeps its
+// volume. The computed one keeps its volume within 4e-3 and its spurious
+// stress (from the grid velocity near the free surface, where the particles
+// do not surround a node, spreading inward as waves) is a discretisation
+// error: it falls when the cells are halved, for every method and scheme.
+TEST(RigidRotation, ElasticDiskSpuriousStressFallsUnderRefinement) {
+  for (Method method : kMethods)
+    for (Scheme scheme : kSchemes) {
+      SCOPED_TRACE(label(method, scheme));
+      const RotationResult coarse = quarter_turn(method, scheme, kSolid, 32);
+      const RotationResult fine = quarter_turn(method, scheme, kSolid, 64);
+      const std::string name = label(method, scheme);
+      RecordProperty("volume_change_32_" + name, scientific(coarse.volume_change));
+      RecordProperty("largest_stress_over_mu_32_" + name, scientific(coarse.largest_stress));
+      RecordProperty("interior_stress_over_mu_32_" + name, scientific(coarse.interior_stress));
+      RecordProperty("interior_stress_over_mu_64_" + name, scientific(fine.interior_stress));
+      // Measured |dV/V| at 32 cells: 5.7e-5 to 1.7e-3.
+      EXPECT_LT(std::abs(coarse.volume_change), 4e-3);
+      // Measured max |sigma| / mu at 32 cells: 0.06 (gimp, cpdi USL) to 0.72
+      // (linear USL, one particle crossing a cell edge).
+      EXPECT_LT(coarse.largest_stress, 1.0);
+      // Measured interior ratios fine / coarse: 0.23 to 0.51.
+      EXPECT_LT(fine.interior_stress, 0.7 * coarse.interior_stress);
+    }
+}
+
+// ---------------------------------------------------------------- CPDI domains
+
+// After steps that shear and stretch the body, each CPDI domain is still
+// s_p = F_p diag(l_p) (eq. 1.97) and its corner polygon has the particle's
+// volume V_p = det(F_p) V_p0 (eq. 1.75).
+TEST(CpdiDomain, FollowsTheDeformationGradientAfterSteps) {
+  Model model = disk_model(Method::cpdi);
+  for (std::size_t p = 0; p < model.particles.size(); ++p) {
+    const Vec2 x = model.particles.position[p];
+    model.particles.velocity[p] = Vec2(0.3 * x.y() + 0.1 * x.x(), -0.05 * x.y());
+  }
+  const double dt = stable_step(model);
+  auto stepper = mpmvv::make_stepper(std::move(model), SolverOptions{Method::cpdi, Scheme::usl},
+                                     MaterialModel{kSolid}, nullptr);
+  advance(*stepper, 10, dt);
+  const Particles& P = stepper->model().particles;
+  const mpmvv::CpdiShape shape = mpmvv::CpdiShape::bind(stepper->model().grid, P);
+  double largest_shear = 0.0;
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    const Mat2& F = P.deformation_gradient[p];
+    largest_shear = std::max(largest_shear, std::abs(F(0, 1)));
+    const Mat2 expected = F * P.half_size[p].asDiagonal();
+    const Mat2 s = shape.domain(p);
+    EXPECT_LT((s - expected).norm(), 1e-15 * expected.norm());
+    double twice_area = 0.0;
+    for (int c = 0; c < 4; ++c) {
+      const Vec2 a = shape.corner(p, s, c), b = shape.corner(p, s, (c + 1) % 4);
+      EXPECT_LT((a - (P.position[p] + mpmvv::CpdiShape::corner_xi[c] * s.col(0) +
+                      mpmvv::CpdiShape::corner_eta[c] * s.col(1))).norm(), 1e-15);
+      twice_area += a.x() * b.y() - b.x() * a.y();
+    }
+    // Coordinates of order 1 m give areas of order 4e-3 m^2: 1e-10 relative
+    // covers the cancellation of the shoelace sum.
+    EXPECT_NEAR(0.5 * twice_area, P.volume[p], 1e-10 * P.volume[p]);
+  }
+  // The steps really sheared the domains (measured max |F_xy| about 0.1).
+  EXPECT_GT(largest_shear, 1e-2);
+}
+
+// ---------------------------------------------------------------- failures as data
+
+class NullObserver final : public mpmvv::RunObserver {};
+
+// Records the time after every step.
+class StepTimes final : public mpmvv::RunObserver {
+ public:
+  void after_step(double t, const Stepper&) override { times.push_back(t); }
+  std::vector<double> times;
+};
+
+mpmvv::TimeLoopOptions short_run(double end_time) {
+  mpmvv::TimeLoopOptions o;
+  o.end_time = end_time;
+  o.cfl = 0.3;
+  o.output_times = {end_time};
+  return o;
+}
+
+// A particle that starts outside the grid, one with det F <= 0 and one with a
+// NaN velocity each stop the run before the first step, as data: the reason,
+// time 0, step 0 and the particle's index.
+TEST(TimeLoop, BadInitialParticleIsReportedAsData) {
+  struct Case {
+    const char* reason;
+    void (*spoil)(Particles&, std::size_t);
+  };
+  const Case cases[] = {
+      {"outside grid", [](Particles& P, std::size_t p) { P.position[p] = Vec2(2.5, 0.0); }},
+      {"non-positive J",
+       [](Particles& P, std::size_t p) { P.deformation_gradient[p] = Vec2(1.0, -1.0).asDiagonal(); }},
+      {"nan", [](Particles& P, std::size_t p) { P.velocity[p].x() = std::numeric_limits<double>::quiet_NaN(); }},
+  };
+  for (Method method : kMethods)
+    for (const Case& c : cases) {
+      SCOPED_TRACE(std::string(to_string(method)) + ": " + c.reason);
+      Model model = disk_model(method);
+      const std::size_t bad = model.particles.size() / 3;
+      c.spoil(model.particles, bad);
+      auto stepper = mpmvv::make_stepper(std::move(model), SolverOptions{method, Scheme::usl},
+                                         MaterialModel{kSolid}, nullptr);
+      NullObserver observer;
+      const mpmvv::RunOutcome o = mpmvv::run_time_loop(*stepper, short_run(0.1), observer);
+      EXPECT_FALSE(o.completed);
+      EXPECT_EQ(o.failure_reason, c.reason);
+      EXPECT_FALSE(o.failure_detail.empty());
+      EXPECT_EQ(o.failure_time, 0.0);
+      EXPECT_EQ(o.failure_step, 0);
+      EXPECT_EQ(o.failure_particle, static_cast<long long>(bad));
+      EXPECT_EQ(o.steps, 0);
+      EXPECT_EQ(o.time_reached, 0.0);
+      EXPECT_EQ(o.outputs_written, 0u);
+    }
+}
+
+// A body force that turns NaN for one lone particle from t = 0.2 s on.
+class PoisonAfter final : public mpmvv::BodyForce {
+ public:
+  PoisonAfter(std::size_t particle, double time) : particle_(particle), time_(time) {}
+  void evaluate(double t, const Particles& P, std::vector<Vec2>& b) const override {
+    std::fill(b.begin(), b.begin() + std::ptrdiff_t(P.size()), Vec2::Zero());
+    if (t >= time_) b[particle_] = Vec2(std::numeric_limits<double>::quiet_NaN(), 0.0);
+  }
+
+ private:
+  std::size_t particle_;
+  double time_;
+};
+
+// A particle that goes bad during the run stops it at the end of that step:
+// failure_time is the time that step reached and failure_step its number.
+TEST(TimeLoop, FailureDuringTheRunRecordsTimeAndStep) {
+  for (Method method : kMethods) {
+    SCOPED_TRACE(to_string(method));
+    Model model = disk_model(method);
+    add_particle(model, method, Vec2(1.5, 1.5));  // far from the disk: only it is poisoned
+    const std::size_t lone = model.particles.size() - 1;
+    auto stepper = mpmvv::make_stepper(std::move(model), SolverOptions{method, Scheme::usl},
+                                       MaterialModel{kSolid}, std::make_shared<PoisonAfter>(lone, 0.2));
+    StepTimes observer;
+    const mpmvv::RunOutcome o = mpmvv::run_time_loop(*stepper, short_run(1.0), observer);
+    EXPECT_FALSE(o.completed);
+    EXPECT_EQ(o.failure_reason, "nan");
+    EXPECT_EQ(o.failure_particle, static_cast<long long>(lone));
+    const std::size_t n = observer.times.size();
+    ASSERT_GE(n, 3u);
+    // The first step that starts at t >= 0.2 s is the last one taken.
+    EXPECT_EQ(o.failure_step, static_cast<long long>(n));
+    EXPECT_EQ(o.steps, o.failure_step);
+    EXPECT_EQ(o.failure_time, observer.times.back());
+    EXPECT_EQ(o.time_reached, o.failure_time);
+    EXPECT_GE(observer.times[n - 2], 0.2);
+    EXPECT_LT(observer.times[n - 3], 0.2);
+  }
+}
+
+// ---------------------------------------------------------------- threads
+
+std::vector<Vec2> positions_after_steps(int threads) {
+  mpmvv::set_threads(threads);
+  Model model = disk_model(Method::cpdi);
+  for (std::size_t p = 0; p < model.particles.size(); ++p) {
+    const Vec2 x = model.particles.position[p];
+    model.particles.velocity[p] = Vec2(0.1 * std::sin(3.0 * x.y()), 0.05 * x.x() * x.x());
+  }
+  const double dt = stable_step(model);
+  auto stepper = mpmvv::make_stepper(std::move(model), SolverOptions{Method::cpdi, Scheme::usl},
+                                     MaterialModel{kSolid}, nullptr);
+  advance(*stepper, 20, dt);
+  return stepper->model().particles.position;
+}
+
+// The same thread count gives bit-for-bit the same run; one and two threads
+// differ only by the order of the node sums.
+TEST(Threads, RunsAreRepeatable) {
+  const int default_threads = mpmvv::max_threads();
+  mpmvv::set_threads(2);
+  const bool two_threads = mpmvv::max_threads() == 2;
+  mpmvv::set_threads(default_threads);
+  if (!two_threads) GTEST_SKIP() << "built without OpenMP";
+  const std::vector<Vec2> first = positions_after_steps(2), second = positions_after_steps(2);
+  const std::vector<Vec2> single = positions_after_steps(1);
+  mpmvv::set_threads(default_threads);
+  ASSERT_EQ(first.size(), second.size());
+  ASSERT_EQ(first.size(), single.size());
+  double largest = 0.0;
+  for (std::size_t p = 0; p < first.size(); ++p) {
+    EXPECT_EQ(first[p].x(), second[p].x()) << "particle " << p;
+    EXPECT_EQ(first[p].y(), second[p].y()) << "particle " << p;
+    largest = std::max(largest, (first[p] - single[p]).norm() / first[p].norm());
+  }
+  RecordProperty("one_versus_two_threads", scientific(largest));
+  // Measured largest relative difference 0 to a few 1e-16: round-off of the
+  // reordered sums.
+  EXPECT_LT(largest, 1e-12);
+}
+
+// ---------------------------------------------------------------- time loop
+
+// Passes every call to a real stepper and records what the time loop asked
+// for, with the CFL bound at that moment.
+class RecordingStepper final : public Stepper {
+ public:
+  struct Call {
+    double t, dt, kick, cfl_bound;
+  };
+
+  RecordingStepper(std::unique_ptr<Stepper> inner, double cfl)
+      : Stepper(inner->model()), inner_(std::move(inner)), cfl_(cfl) {}
+
+  void step(double t, double dt, double kick) override {
+    const double bound = cfl_ * inner_->model().grid.h / inner_->scan().max_signal_speed;
+    calls.push_back({t, dt, kick, bound});
+    inner_->step(t, dt, kick);
+  }
+  mpmvv::ParticleScan scan() const override { return inner_->scan(); }
+  mpmvv::ParticleFault diagnose(std::size_t p) const override { return inner_->diagnose(p); }
+
+  std::vector<Call> calls;
+
+ private:
+  std::unique_ptr<Stepper> inner_;
+  double cfl_;
+};
+
+class OutputTimes final : public mpmvv::RunObserver {
+ public:
+  void at_output(std::size_t index, double t, const Stepper&) override { outputs.emplace_back(index, t); }
+  std::vector<std::pair<std::size_t, double>> outputs;
+};
+
+// The loop lands exactly on every output time, never takes a step longer
+// than cfl h / max(c + |v|), passes each step the time the last one reached,
+// and kicks by dt/2 first and by the mean of adjacent steps after
+// (central differences).
+TEST(TimeLoop, LandsOnOutputTimesWithinTheCflStep) {
+  Model model = disk_model(Method::gimp);
+  for (std::size_t p = 0; p < model.particles.size(); ++p) {
+    const Vec2 x = model.particles.position[p];
+    model.particles.velocity[p] = Vec2(0.4 * x.y(), -0.3 * x.x());
+  }
+  mpmvv::TimeLoopOptions options;
+  options.cfl = 0.4;
+  options.end_time = 0.5;
+  options.output_times = {0.03, 0.1, 1.0 / 3.0, 0.35, 0.5};
+  auto inner = mpmvv::make_stepper(std::move(model), SolverOptions{Method::gimp, Scheme::usl},
+                                   MaterialModel{kSolid}, nullptr);
+  RecordingStepper stepper(std::move(inner), options.cfl);
+  OutputTimes observer;
+  const mpmvv::RunOutcome o = mpmvv::run_time_loop(stepper, options, observer);
+
+  ASSERT_TRUE(o.completed) << o.failure_reason;
+  EXPECT_EQ(o.time_reached, options.end_time);
+  EXPECT_EQ(o.outputs_written, options.output_times.size());
+  ASSERT_EQ(observer.outputs.size(), options.output_times.size());
+  for (std::size_t k = 0; k < observer.outputs.size(); ++k) {
+    EXPECT_EQ(observer.outputs[k].first, k);
+    EXPECT_EQ(observer.outputs[k].second, options.output_times[k]);
+  }
+  ASSERT_EQ(stepper.calls.size(), std::size_t(o.steps));
+  double reached = 0.0;
+  for (std::size_t k = 0; k < stepper.calls.size(); ++k) {
+    const RecordingStepper::Call& c = stepper.calls[k];
+    SCOPED_TRACE("step " + std::to_string(k));
+    EXPECT_LE(c.dt, c.cfl_bound);
+    EXPECT_GT(c.dt, 0.0);
+    EXPECT_EQ(c.t, reached);
+    const double expected_kick = k == 0 ? 0.5 * c.dt : 0.5 * (stepper.calls[k - 1].dt + c.dt);
+    EXPECT_EQ(c.kick, expected_kick);
+    const auto landing = std::find_if(options.output_times.begin(), options.output_times.end(),
+                                      [&](double target) { return std::abs(c.t + c.dt - target) < 1e-12; });
+    reached = landing != options.output_times.end() ? *landing : c.t + c.dt;
+  }
+  // Landing never leaves a sliver: the output times here are at least half a
+  // CFL step apart, and the loop splits a last stretch shorter than two steps
+  // in two, so no step is shorter than a quarter of the CFL step.
+  for (const RecordingStepper::Call& c : stepper.calls) EXPECT_GT(c.dt, 0.25 * c.cfl_bound);
+}
+
+// Output times that do not end at the end time are refused before any step.
+TEST(TimeLoop, OutputTimesMustEndAtTheEndTime) {
+  auto stepper = mpmvv::make_stepper(disk_model(Method::linear), SolverOptions{Method::linear, Scheme::usl},
+                                     MaterialModel{kSolid}, nullptr);
+  mpmvv::TimeLoopOptions options = short_run(0.5);
+  options.output_times = {0.25};
+  NullObserver observer;
+  EXPECT_THROW(mpmvv::run_time_loop(*stepper, options, observer), std::invalid_argument);
+}
+
+// A method that needs particle domains refuses particles without them.
+TEST(Solver, MakeStepperRefusesMissingParticleDomains) {
+  for (Method method : {Method::gimp, Method::cpdi}) {
+    Model model = disk_model(Method::linear);
+    EXPECT_THROW(mpmvv::make_stepper(std::move(model), SolverOptions{method, Scheme::usl},
+                                     MaterialModel{kSolid}, nullptr),
+                 std::invalid_argument)
+        << to_string(method);
+  }
+}
+
+}  // namespace

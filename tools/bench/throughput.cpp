@@ -1,0 +1,68 @@
+// Throughput of the explicit step on the ring scene: particle-steps per second
+// for each shape-function family and thread count, best of several repeats.
+// The run is the real scene (body force, tracers, output) from t = 0 over a
+// short interval, so the number is what `mpmvv run` delivers.
+//
+//   mpmvv-bench-throughput [--cells 256] [--end-time 0.1] [--repeats 3] [--threads 1,2]
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "solver/parallel.hpp"
+#include "tools/app/scene.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"Particle-steps per second of the explicit MPM step on the ring scene."};
+  int cells = 256;
+  double end_time = 0.1;
+  int repeats = 3;
+  std::vector<int> threads{1, 2};
+  std::vector<std::string> methods{"linear", "gimp", "cpdi"};
+  std::string scheme = "usl";
+  app.add_option("--cells", cells, "cells across the 3 m domain")->check(CLI::Range(8, 4096));
+  app.add_option("--end-time", end_time, "simulated interval per repeat [s]")->check(CLI::PositiveNumber);
+  app.add_option("--repeats", repeats, "repeats per configuration; the best is reported")->check(CLI::Range(1, 100));
+  app.add_option("--threads", threads, "thread counts")->delimiter(',');
+  app.add_option("--methods", methods, "shape-function families")->delimiter(',');
+  app.add_option("--scheme", scheme, "usl, usf or musl");
+  CLI11_PARSE(app, argc, argv);
+
+  fmt::print("ring scene, {} cells, 2 particles per cell per direction, A = 0.5, {} to t = {} s, best of {}\n", cells,
+             scheme, end_time, repeats);
+  fmt::print("{:>7} {:>8} {:>10} {:>7} {:>16} {:>14} {:>12}\n", "method", "threads", "particles", "steps",
+             "particle-steps/s", "ns/particle-step", "forcing share");
+  for (const std::string& method : methods) {
+    for (int t : threads) {
+      mpmvv::set_threads(t);
+      double best_rate = 0.0, forcing_share = 0.0;
+      long long steps = 0;
+      std::size_t particles = 0;
+      for (int r = 0; r < repeats; ++r) {
+        mpmvv::app::Config config("ring", mpmvv::app::find_scene_type("ring")->keys());
+        for (const std::string& o : {"method=" + method, "scheme=" + scheme, "cells=" + std::to_string(cells),
+                                     fmt::format("end_time={}", end_time), fmt::format("output_times={}", end_time)})
+          config.set_from_text(o);
+        auto scene = mpmvv::app::find_scene_type("ring")->build(config);
+        const mpmvv::RunOutcome o = scene->run({});
+        if (!o.completed) {
+          fmt::print(stderr, "{} stopped: {} {}\n", method, o.failure_reason, o.failure_detail);
+          return 1;
+        }
+        const double rate = double(o.particle_steps) / o.wall_seconds;
+        if (rate > best_rate) {
+          best_rate = rate;
+          forcing_share = o.forcing_seconds / o.wall_seconds;
+        }
+        steps = o.steps;
+        particles = scene->particle_count();
+      }
+      fmt::print("{:>7} {:>8} {:>10} {:>7} {:>16.3e} {:>14.1f} {:>11.1f}%\n", method, t, particles, steps, best_rate,
+                 1e9 / best_rate, 100.0 * forcing_share);
+    }
+  }
+  return 0;
+}
