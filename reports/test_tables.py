@@ -1,0 +1,33 @@
+"""Requirements of the convergence tables: an error that is exactly C h^2
+gives observed order 2 between every pair of meshes, and a stopped run is
+reported with its reason and time instead of numbers."""
+import math
+
+import convergence_table
+import study_table
+from conftest import write_ring_results
+
+
+def test_observed_order_of_c_h_squared_is_two():
+    h = [0.1, 0.05, 0.025]
+    e = [3.0 * x * x for x in h]
+    for a, b in zip(range(2), range(1, 3)):
+        assert math.isclose(convergence_table.observed_order(e[a], e[b], h[a], h[b]), 2.0, rel_tol=1e-12)
+
+
+def test_convergence_table_prints_order_two(second_order_series, capsys):
+    assert convergence_table.main(second_order_series) == 0
+    out = capsys.readouterr().out
+    assert out.count("  2.00") >= 4  # two pairs of meshes, two output times, on the Theta = 0 norm at least
+
+
+def test_study_table_orders_and_failures(second_order_series, tmp_path, capsys):
+    failed = tmp_path / "ring-256.h5"
+    write_ring_results(failed, 256, [0.1], [0.25], status="failed", failure_reason="nan", failure_time=0.31)
+    assert study_table.main(second_order_series + [str(failed)]) == 0
+    out = capsys.readouterr().out
+    assert "failed t=0.310 (nan)" in out
+    rows = [line for line in out.splitlines() if line.strip().startswith(("64", "128"))]
+    assert len(rows) == 2
+    for row in rows:
+        assert row.split()[-1] == "2.00" and row.split()[-3] == "2.00"
