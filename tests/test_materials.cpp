@@ -3,6 +3,8 @@
 // modulus the time step relies on (000_1dbcb8acb6dddab9.txt eqs. 2.2, 2.18).
 #include <gtest/gtest.h>
 
+#include "deformations.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -25,30 +27,11 @@ const NeoHookean kNeoHookean{577.0, 385.0};
 const MooneyRivlin kMooneyRivlin{150.0, 50.0, 800.0};
 const MooneyRivlin kMooneyRivlinWithoutC2{200.0, 0.0, 800.0};
 
-Mat2 rotation(double angle) {
-  Mat2 q;
-  q << std::cos(angle), -std::sin(angle), std::sin(angle), std::cos(angle);
-  return q;
-}
+using mpmvv::testing::rotation;
+using mpmvv::testing::simple_shear;
 
-Mat2 simple_shear(double gamma) {
-  Mat2 f;
-  f << 1.0, gamma, 0.0, 1.0;
-  return f;
-}
-
-// Random F with det F in [0.3, ...) and entries of order one.
-Mat2 random_deformation(std::mt19937& rng) {
-  std::uniform_real_distribution<double> u(-0.7, 0.7);
-  for (;;) {
-    Mat2 f = Mat2::Identity();
-    f(0, 0) += u(rng);
-    f(0, 1) += u(rng);
-    f(1, 0) += u(rng);
-    f(1, 1) += u(rng);
-    if (mpmvv::determinant(f) >= 0.3) return f;
-  }
-}
+// Random F with det F >= 0.3 and entries of order one.
+Mat2 random_deformation(std::mt19937& rng) { return mpmvv::testing::random_deformation(rng, 0.7, 0.3); }
 
 std::string show(const Mat2& a) {
   std::ostringstream text;

@@ -58,6 +58,8 @@ TEST(ResultsFile, CompletedRunHoldsTheDocumentedLayout) {
   EXPECT_EQ(root.attribute_int("particles_per_direction"), 2);
   EXPECT_EQ(root.attribute_int("cells"), 32);
   EXPECT_NE(root.attribute_string("configuration").find("cells = 32"), std::string::npos);
+  EXPECT_NE(root.attribute_string("scene_file_text").find("scene = \"ring\""), std::string::npos);
+  EXPECT_EQ(root.attribute_string("overrides"), "cells=32\nend_time=0.25\noutput_times=0.1");
   EXPECT_NE(root.attribute_string("version").find("mpmvv"), std::string::npos);
   // Every scene key is an attribute of its own.
   for (const mpmvv::app::KeySpec& key : mpmvv::app::find_scene_type("ring")->keys())

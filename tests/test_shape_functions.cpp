@@ -5,6 +5,8 @@
 // +-(h + l), and the last positions `inside` still accepts next to a wall.
 #include <gtest/gtest.h>
 
+#include "deformations.hpp"
+
 #include <cmath>
 #include <cstddef>
 #include <random>
@@ -208,17 +210,8 @@ TYPED_TEST(ShapeFunctionTest, NanPositionIsNotInside) {
 
 // ---------------------------------------------------------------- CPDI with deformed domains
 
-Mat2 rotation(double angle) {
-  Mat2 q;
-  q << std::cos(angle), -std::sin(angle), std::sin(angle), std::cos(angle);
-  return q;
-}
-
-Mat2 simple_shear(double gamma) {
-  Mat2 f;
-  f << 1.0, gamma, 0.0, 1.0;
-  return f;
-}
+using mpmvv::testing::rotation;
+using mpmvv::testing::simple_shear;
 
 Mat2 rotated_stretch() {
   Mat2 stretch;
@@ -227,17 +220,7 @@ Mat2 rotated_stretch() {
 }
 
 // Random F with det F >= 0.2 and entries of order one.
-Mat2 random_deformation(std::mt19937& rng) {
-  std::uniform_real_distribution<double> u(-0.8, 0.8);
-  for (;;) {
-    Mat2 f = Mat2::Identity();
-    f(0, 0) += u(rng);
-    f(0, 1) += u(rng);
-    f(1, 0) += u(rng);
-    f(1, 1) += u(rng);
-    if (mpmvv::determinant(f) >= 0.2) return f;
-  }
-}
+Mat2 random_deformation(std::mt19937& rng) { return mpmvv::testing::random_deformation(rng, 0.8, 0.2); }
 
 // (a)-(c) for CPDI domains under simple shear and under a rotated stretch, at
 // interior positions and on edges. Weights stay non-negative (they are

@@ -74,11 +74,11 @@ std::string format_value(const Value& v) {
       [](const auto& x) -> std::string {
         using T = std::decay_t<decltype(x)>;
         if constexpr (std::is_same_v<T, std::int64_t>) return std::to_string(x);
-        else if constexpr (std::is_same_v<T, double>) return fmt::format("{:.17g}", x);
+        else if constexpr (std::is_same_v<T, double>) return fmt::format("{}", x);  // shortest round-trip
         else if constexpr (std::is_same_v<T, std::string>) return "\"" + x + "\"";
         else {
           std::string s = "[";
-          for (std::size_t i = 0; i < x.size(); ++i) s += (i ? ", " : "") + fmt::format("{:.17g}", x[i]);
+          for (std::size_t i = 0; i < x.size(); ++i) s += (i ? ", " : "") + fmt::format("{}", x[i]);
           return s + "]";
         }
       },

@@ -2,8 +2,11 @@
 
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdio>
+#include <memory>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <sstream>
 
@@ -62,6 +65,12 @@ void write_results_file(const std::string& path, const RunRequest& request, cons
   root.set_attribute("scene", config.scene());
   root.set_attribute("configuration", config.to_toml());
   root.set_attribute("scene_file", request.scene_file);
+  {
+    std::ifstream in(request.scene_file);
+    std::ostringstream text;
+    text << in.rdbuf();
+    root.set_attribute("scene_file_text", text.str());
+  }
   std::string overrides;
   for (const std::string& s : request.overrides) overrides += (overrides.empty() ? "" : "\n") + s;
   root.set_attribute("overrides", overrides);
@@ -91,16 +100,20 @@ void write_results_file(const std::string& path, const RunRequest& request, cons
   file.flush();
 }
 
+// On a terminal one line rewritten every second; in a log a new line every
+// ten seconds.
 ProgressSink progress_printer(std::ostream& err) {
   const bool tty = isatty(fileno(stderr));
-  return [&err, tty](const Progress& p) {
+  auto last_line = std::make_shared<std::chrono::steady_clock::time_point>(std::chrono::steady_clock::now());
+  return [&err, tty, last_line](const Progress& p) {
     const std::string line =
         fmt::format("step {:>7}  t = {:.4g} / {:.4g} s  {:.3g} particle-steps/s  ETA {:.0f} s", p.step, p.time,
                     p.end_time, p.particle_steps_per_second, p.eta_seconds);
     if (tty) {
       fmt::print(err, "\r{:<78}", p.final ? fmt::format("step {:>7}  t = {:.4g} s  done", p.step, p.time) : line);
       if (p.final) fmt::print(err, "\n");
-    } else if (!p.final) {
+    } else if (!p.final && std::chrono::steady_clock::now() - *last_line >= std::chrono::seconds(10)) {
+      *last_line = std::chrono::steady_clock::now();
       fmt::print(err, "{}\n", line);
     }
     err.flush();

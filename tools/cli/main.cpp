@@ -42,6 +42,19 @@ int main(int argc, char** argv) {
 
   app.add_subcommand("scenes", "List the scenes and the keys each accepts.");
 
+  if (argc > 1 && argv[1][0] != '-') {
+    bool known = false;
+    std::string commands;
+    for (const CLI::App* sub : app.get_subcommands({})) {
+      known = known || sub->get_name() == argv[1];
+      commands += (commands.empty() ? "" : ", ") + sub->get_name();
+    }
+    if (!known) {
+      fmt::print(stderr, "mpmvv: unknown command '{}' (commands: {}; see mpmvv --help)\n", argv[1], commands);
+      return 2;
+    }
+  }
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -1,0 +1,39 @@
+// Deformation gradients the tests share.
+#pragma once
+
+#include <cmath>
+#include <random>
+
+#include "solver/tensor.hpp"
+
+namespace mpmvv::testing {
+
+inline Mat2 rotation(double angle) {
+  Mat2 q;
+  q << std::cos(angle), -std::sin(angle), std::sin(angle), std::cos(angle);
+  return q;
+}
+
+// x = X + gamma Y e_x.
+inline Mat2 simple_shear(double gamma) {
+  Mat2 f;
+  f << 1.0, gamma, 0.0, 1.0;
+  return f;
+}
+
+// Random F = I + perturbation, entries uniform in [-spread, spread], redrawn
+// until det F >= min_det.
+template <class Rng>
+Mat2 random_deformation(Rng& rng, double spread, double min_det) {
+  std::uniform_real_distribution<double> u(-spread, spread);
+  for (;;) {
+    Mat2 f = Mat2::Identity();
+    f(0, 0) += u(rng);
+    f(0, 1) += u(rng);
+    f(1, 0) += u(rng);
+    f(1, 1) += u(rng);
+    if (determinant(f) >= min_det) return f;
+  }
+}
+
+}  // namespace mpmvv::testing
