@@ -13,7 +13,13 @@
 #include <cmath>
 #include <numbers>
 
+#include <Eigen/Core>
+
+#include <stdexcept>
+#include <vector>
+
 #include "solver/material/neo_hookean.hpp"
+#include "solver/model.hpp"
 #include "solver/tensor.hpp"
 
 namespace mpmvv::mms {
@@ -31,6 +37,39 @@ struct RingParameters {
   double lambda = 577.0;        // [Pa], report eq. 2.2
   double mu = 385.0;            // [Pa]
   double density = 1000.0;      // rho_0 [kg/m^3]
+};
+
+// The motion alone, generic over the scalar, for the generator
+// (manufactured.hpp): x = Q(alpha) X with alpha = g(t) h(|X|), the rotation
+// form of eq. 2.1 (it avoids atan2).
+struct RingMotion {
+  RingParameters p;
+
+  template <class S>
+  S g(const S& t) const {
+    using std::cos;
+    using std::numbers::pi;
+    using std::sin;
+    return p.time_function == RingTimeFunction::cosine ? S(0.5 * p.amplitude) * (S(1.0) - cos(S(2.0 * pi) * t))
+                                                       : S(p.amplitude) * sin(S(pi) * t);
+  }
+  template <class S>
+  S h(const S& R) const {
+    const S s = (R - S(0.5 * (p.inner_radius + p.outer_radius))) / S(0.5 * (p.outer_radius - p.inner_radius));
+    const S q = S(1.0) - s * s;
+    return q * q;
+  }
+  template <class S>
+  Eigen::Matrix<S, 2, 1> position(const Eigen::Matrix<S, 2, 1>& X, const S& t) const {
+    using std::cos;
+    using std::sin;
+    using std::sqrt;
+    const S alpha = g(t) * h(S(sqrt(X.x() * X.x() + X.y() * X.y())));
+    const S c = cos(alpha), s = sin(alpha);
+    return {c * X.x() - s * X.y(), s * X.x() + c * X.y()};
+  }
+  double length_scale() const { return p.outer_radius - p.inner_radius; }
+  double time_scale() const { return 1.0; }
 };
 
 // Exact fields at one material point and time.
@@ -164,6 +203,38 @@ class RingMms {
 
   RingParameters p_;
   NeoHookean material_;
+};
+
+// The closed form as the solver's body-force stage, for the neo-Hookean ring.
+// The radial factors and the direction of each particle's reference position
+// never change, so they are kept per particle; a step then costs one
+// time-function evaluation and one sin/cos pair per particle.
+// tests/test_manufactured.cpp shows it equals the derived force to round-off.
+class RingClosedFormBodyForce final : public BodyForce {
+ public:
+  explicit RingClosedFormBodyForce(const RingMms& mms) : mms_(mms) {}
+
+  void prepare(const Particles& P) override {
+    radial_.clear();
+    direction_.clear();
+    for (const Vec2& X : P.reference_position) {
+      radial_.push_back(mms_.radial(X.norm()));
+      direction_.push_back(X / X.norm());
+    }
+  }
+
+  void evaluate(double t, const Particles& P, std::vector<Vec2>& b) const override {
+    const std::size_t n = P.size();
+    if (n != radial_.size()) throw std::logic_error("ring body force: prepare() was not called for these particles");
+    const RingMms::Temporal q = mms_.temporal(t);
+#pragma omp parallel for schedule(static)
+    for (std::size_t p = 0; p < n; ++p) b[p] = mms_.body_force(radial_[p], direction_[p].x(), direction_[p].y(), q);
+  }
+
+ private:
+  RingMms mms_;
+  std::vector<RingMms::Radial> radial_;
+  std::vector<Vec2> direction_;  // X_p / |X_p|: (cos Theta_p, sin Theta_p)
 };
 
 }  // namespace mpmvv::mms

@@ -40,13 +40,16 @@ template <class Shape, class Material>
 class ExplicitStepper final : public Stepper {
  public:
   ExplicitStepper(Model model, Scheme scheme, Material material,
-                  std::shared_ptr<const BodyForce> body_force)
+                  std::shared_ptr<BodyForce> body_force)
       : Stepper(std::move(model)),
         scheme_(scheme),
         material_(material),
         body_force_(std::move(body_force)) {
     buffers_.resize(max_threads(), model_.grid.node_count());
-    if (body_force_) model_.particles.body_force.assign(model_.particles.size(), Vec2::Zero());
+    if (body_force_) {
+      body_force_->prepare(model_.particles);
+      model_.particles.body_force.assign(model_.particles.size(), Vec2::Zero());
+    }
     if (scheme_ == Scheme::musl) next_position_.resize(model_.particles.size());
   }
 
@@ -69,7 +72,10 @@ class ExplicitStepper final : public Stepper {
     if (!(x.allFinite() && P.velocity[p].allFinite() && P.deformation_gradient[p].allFinite() &&
           P.stress[p].allFinite()))
       return {"nan", fmt::format("non-finite state at x = ({:.6g}, {:.6g})", x.x(), x.y())};
-    const double J = determinant(P.deformation_gradient[p]);
+    if constexpr (Shape::geometry == Geometry::axisymmetric)
+      if (!std::isfinite(P.hoop_stress[p]))
+        return {"nan", fmt::format("non-finite hoop stress at x = ({:.6g}, {:.6g})", x.x(), x.y())};
+    const double J = determinant(P.deformation_gradient[p]) * out_of_plane_stretch<Shape::geometry>(P, p);
     if (!(J > 0.0)) return {"non-positive J", fmt::format("J = {:.6g} at x = ({:.6g}, {:.6g})", J, x.x(), x.y())};
     if (!shape.inside(p))
       return {"outside grid", fmt::format("support of the particle at ({:.6g}, {:.6g}) leaves the grid", x.x(), x.y())};
@@ -84,10 +90,10 @@ class ExplicitStepper final : public Stepper {
     const Shape shape = Shape::bind(model_.grid, P);
     map_mass_momentum_and_forces(shape, t);
     update_grid_motion(fields_, kick);
-    apply_roller_walls(model_.grid, fields_);
+    apply_walls(model_.grid, fields_);
     move_tracers(dt);
     grid_to_particles<kVelocity | kPosition | kDeformation, Shape>(shape, fields_, P, dt, kick);
-    update_stress(material_, P);
+    update_stress<Shape::geometry>(material_, P);
   }
 
   // Update stress first: F and stress from the grid velocity at t_n, then the
@@ -105,9 +111,9 @@ class ExplicitStepper final : public Stepper {
     const Shape shape = Shape::bind(model_.grid, P, domain_deformation);
     particles_to_grid<kMass | kMomentum>(shape, P, buffers_, fields_);
     grid_velocity_from_momentum(fields_);
-    apply_roller_walls(model_.grid, fields_);
+    apply_walls(model_.grid, fields_);
     grid_to_particles<kDeformation, Shape>(shape, fields_, P, dt, kick);
-    update_stress(material_, P);
+    update_stress<Shape::geometry>(material_, P);
     if (body_force_) {
       evaluate_body_force(t);
       particles_to_grid<kInternalForce | kBodyForce>(shape, P, buffers_, fields_);
@@ -115,7 +121,7 @@ class ExplicitStepper final : public Stepper {
       particles_to_grid<kInternalForce>(shape, P, buffers_, fields_);
     }
     update_grid_motion(fields_, kick);
-    apply_roller_walls(model_.grid, fields_);
+    apply_walls(model_.grid, fields_);
     move_tracers(dt);
     grid_to_particles<kVelocity | kPosition, Shape>(shape, fields_, P, dt, kick);
   }
@@ -127,15 +133,15 @@ class ExplicitStepper final : public Stepper {
     const Shape shape = Shape::bind(model_.grid, P);
     map_mass_momentum_and_forces(shape, t);
     update_grid_motion(fields_, kick);
-    apply_roller_walls(model_.grid, fields_);
+    apply_walls(model_.grid, fields_);
     move_tracers(dt);
     grid_to_particles<kVelocity | kPosition, Shape>(shape, fields_, P, dt, kick, next_position_.data());
     particles_to_grid<kMomentum>(shape, P, buffers_, fields_);
     grid_velocity_from_momentum(fields_);
-    apply_roller_walls(model_.grid, fields_);
+    apply_walls(model_.grid, fields_);
     grid_to_particles<kDeformation, Shape>(shape, fields_, P, dt, kick);
     P.position.swap(next_position_);
-    update_stress(material_, P);
+    update_stress<Shape::geometry>(material_, P);
   }
 
   void map_mass_momentum_and_forces(const Shape& shape, double t) {
@@ -160,7 +166,7 @@ class ExplicitStepper final : public Stepper {
 
   Scheme scheme_;
   Material material_;
-  std::shared_ptr<const BodyForce> body_force_;
+  std::shared_ptr<BodyForce> body_force_;
   ScatterBuffers buffers_;
   std::vector<Vec2> next_position_;  // MUSL only: x_{n+1} while x_n still sets the weights
   std::vector<Mat2> step_start_deformation_;  // USF with CPDI only: F_n, which sets the domains
@@ -168,7 +174,7 @@ class ExplicitStepper final : public Stepper {
 
 template <class Shape>
 std::unique_ptr<Stepper> make_for_shape(Model model, const SolverOptions& o, const MaterialModel& material,
-                                        std::shared_ptr<const BodyForce> body_force) {
+                                        std::shared_ptr<BodyForce> body_force) {
   return std::visit(
       [&](const auto& m) -> std::unique_ptr<Stepper> {
         using Material = std::decay_t<decltype(m)>;
@@ -177,22 +183,39 @@ std::unique_ptr<Stepper> make_for_shape(Model model, const SolverOptions& o, con
       material);
 }
 
+template <Geometry G>
+std::unique_ptr<Stepper> make_for_geometry(Model model, const SolverOptions& o, const MaterialModel& material,
+                                           std::shared_ptr<BodyForce> body_force) {
+  switch (o.method) {
+    case Method::linear: return make_for_shape<LinearShapeT<G>>(std::move(model), o, material, std::move(body_force));
+    case Method::gimp: return make_for_shape<GimpShapeT<G>>(std::move(model), o, material, std::move(body_force));
+    case Method::cpdi: return make_for_shape<CpdiShapeT<G>>(std::move(model), o, material, std::move(body_force));
+  }
+  throw std::logic_error("unknown method");
+}
+
 }  // namespace
 
 std::unique_ptr<Stepper> make_stepper(Model model, const SolverOptions& options,
                                       const MaterialModel& material,
-                                      std::shared_ptr<const BodyForce> body_force) {
+                                      std::shared_ptr<BodyForce> body_force) {
   const std::size_t n = model.particles.size();
   if (n == 0) throw std::invalid_argument("the scene seeded no particles");
   if (options.method != Method::linear && model.particles.half_size.size() != n)
     throw std::invalid_argument(fmt::format("method {} needs a particle domain (half_size) for every particle",
                                             to_string(options.method)));
-  switch (options.method) {
-    case Method::linear: return make_for_shape<LinearShape>(std::move(model), options, material, std::move(body_force));
-    case Method::gimp: return make_for_shape<GimpShape>(std::move(model), options, material, std::move(body_force));
-    case Method::cpdi: return make_for_shape<CpdiShape>(std::move(model), options, material, std::move(body_force));
+  if (options.geometry == Geometry::axisymmetric) {
+    if (model.particles.hoop_stretch.size() != n || model.particles.hoop_stress.size() != n)
+      throw std::invalid_argument("an axisymmetric run needs the hoop stretch and hoop stress of every particle");
+    for (std::size_t p = 0; p < n; ++p)
+      if (!(model.particles.position[p].x() > 0.0))
+        throw std::invalid_argument(fmt::format("an axisymmetric run needs every particle off the axis (r > 0); "
+                                                "particle {} is at r = {}", p, model.particles.position[p].x()));
+    if (model.grid.wall_lower().x() != 0.0)
+      throw std::invalid_argument("an axisymmetric grid has its left wall on the axis r = 0");
+    return make_for_geometry<Geometry::axisymmetric>(std::move(model), options, material, std::move(body_force));
   }
-  throw std::logic_error("unknown method");
+  return make_for_geometry<Geometry::plane_strain>(std::move(model), options, material, std::move(body_force));
 }
 
 }  // namespace mpmvv

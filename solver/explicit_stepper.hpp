@@ -46,6 +46,6 @@ class Stepper {
 // instantiation for (method, material): the one dispatch.
 std::unique_ptr<Stepper> make_stepper(Model model, const SolverOptions& options,
                                       const MaterialModel& material,
-                                      std::shared_ptr<const BodyForce> body_force);
+                                      std::shared_ptr<BodyForce> body_force);
 
 }  // namespace mpmvv

@@ -10,11 +10,23 @@
 namespace mpmvv {
 
 // Geometry only: where the nodes are. Node (i, j) sits at origin + h (i, j).
+// The walls are the node lines `ghost_layers` cells inside the grid's edges:
+// a body may touch a wall, and particle domains that reach past it interpolate
+// the ghost nodes beyond, which mirror the nodes inside (apply_walls).
 struct GridGeometry {
-  Vec2 origin{0.0, 0.0};  // lower-left corner of the domain
+  Vec2 origin{0.0, 0.0};  // lower-left corner of the grid, ghost layers included
   double h = 1.0;         // cell size, the same along both axes
-  int cells_x = 1;
+  int cells_x = 1;        // ghost layers included
   int cells_y = 1;
+  int ghost_layers = 0;   // cells beyond each wall
+
+  // A grid whose walls enclose [lower, lower + h (walled_cells_x, walled_cells_y)]
+  // with `ghost` cells beyond each wall.
+  static GridGeometry walled(const Vec2& lower, double h, int walled_cells_x, int walled_cells_y, int ghost = 1) {
+    return {lower - Vec2(ghost * h, ghost * h), h, walled_cells_x + 2 * ghost, walled_cells_y + 2 * ghost, ghost};
+  }
+  Vec2 wall_lower() const { return origin + h * Vec2(ghost_layers, ghost_layers); }
+  Vec2 wall_upper() const { return origin + h * Vec2(cells_x - ghost_layers, cells_y - ghost_layers); }
 
   int nodes_x() const { return cells_x + 1; }
   int nodes_y() const { return cells_y + 1; }

@@ -7,8 +7,10 @@
 #include <variant>
 #include <vector>
 
+#include "geometry.hpp"
 #include "grid.hpp"
 #include "material/mooney_rivlin.hpp"
+#include "material/linear_elastic.hpp"
 #include "material/neo_hookean.hpp"
 #include "particles.hpp"
 #include "stages.hpp"
@@ -21,12 +23,13 @@ enum class Scheme { usl, usf, musl };
 const char* to_string(Method m);
 const char* to_string(Scheme s);
 
-using MaterialModel = std::variant<NeoHookean, MooneyRivlin>;
+using MaterialModel = std::variant<NeoHookean, MooneyRivlin, LinearElastic>;
 double p_wave_modulus(const MaterialModel& m);
 
 struct SolverOptions {
   Method method = Method::cpdi;
   Scheme scheme = Scheme::usl;
+  Geometry geometry = Geometry::plane_strain;
 };
 
 // A body force supplied by the scene, per unit mass. One call fills the whole
@@ -34,6 +37,10 @@ struct SolverOptions {
 class BodyForce {
  public:
   virtual ~BodyForce() = default;
+  // Called once, with the particles the run will step (their order is fixed
+  // for the run), before the first evaluate: a force may keep per-particle
+  // factors that never change.
+  virtual void prepare(const Particles&) {}
   virtual void evaluate(double t, const Particles& particles, std::vector<Vec2>& body_force) const = 0;
 };
 

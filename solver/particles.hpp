@@ -28,6 +28,11 @@ struct Particles {
   // its parallelogram with r_i = F_p (l_i e_i), eq. 1.97. Empty for linear MPM.
   std::vector<Vec2> half_size;
 
+  // Axisymmetric runs only: the hoop stretch F_theta (r / R for the exact
+  // motion) and the hoop stress sigma_theta.
+  std::vector<double> hoop_stretch;
+  std::vector<double> hoop_stress;
+
   // Scene-specific: body force per unit mass b_p (eq. 1.71 uses m_p b_p).
   std::vector<Vec2> body_force;
 

@@ -15,7 +15,9 @@
 #include <limits>
 #include <vector>
 
+#include "geometry.hpp"
 #include "grid.hpp"
+#include "material/stress.hpp"
 #include "parallel.hpp"
 #include "particles.hpp"
 #include "shape/linear.hpp"
@@ -29,7 +31,8 @@ namespace mpmvv {
 enum TransferField : unsigned {
   kMass = 1u,           // m_g, eq. 1.69
   kMomentum = 2u,       // m_g v_g, eq. 1.69
-  kInternalForce = 4u,  // -f_g^int = -sum_p V_p sigma_p G_gp, eq. 1.70
+  kInternalForce = 4u,  // -f_g^int = -sum_p V_p sigma_p G_gp, eq. 1.70 (in r-z also
+                        // -sum_p V_p sigma_theta <S_g / r> e_r, the hoop stress)
   kBodyForce = 8u,      // f_g^body = sum_p m_p b_p S_gp
 };
 
@@ -56,6 +59,7 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
   constexpr bool with_internal = Fields & kInternalForce;
   constexpr bool with_body = Fields & kBodyForce;
   constexpr bool with_force = with_internal || with_body;
+  constexpr bool axisymmetric = Shape::geometry == Geometry::axisymmetric;
   const std::size_t n = P.size();
   const std::size_t nodes = g.mass.size();
   const int threads = int(buffers.per_thread.size());
@@ -71,9 +75,11 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
       const double m = P.mass[p];
       Vec2 momentum = Vec2::Zero(), body = Vec2::Zero();
       Mat2 volume_stress = Mat2::Zero();
+      double volume_hoop_stress = 0.0;
       if constexpr (with_momentum) momentum = m * P.velocity[p];
       if constexpr (with_body) body = m * P.body_force[p];
       if constexpr (with_internal) volume_stress = P.volume[p] * P.stress[p];
+      if constexpr (with_internal && axisymmetric) volume_hoop_stress = P.volume[p] * P.hoop_stress[p];
       for (int k = 0; k < Shape::stencil_size; ++k) {
         NodeSums& node = sums[s.node[k]];
         const double w = s.weight[k];
@@ -85,6 +91,7 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
         if constexpr (with_force) {
           Vec2 f = Vec2::Zero();
           if constexpr (with_internal) f -= volume_stress * s.gradient[k];
+          if constexpr (with_internal && axisymmetric) f.x() -= volume_hoop_stress * s.hoop[k];
           if constexpr (with_body) f += w * body;
           node.force_x += f.x();
           node.force_y += f.y();
@@ -139,20 +146,40 @@ inline void grid_velocity_from_momentum(GridFields& g) {
     g.velocity[i] = g.mass[i] > 0.0 ? Vec2(g.momentum[i] / g.mass[i]) : Vec2::Zero();
 }
 
-// Roller (symmetry) walls on the four sides of the domain: nodes on a wall keep
-// no velocity and no acceleration normal to it; tangential motion is free.
-inline void apply_roller_walls(const GridGeometry& grid, GridFields& g) {
-  const int nx = grid.nodes_x(), ny = grid.nodes_y();
+// Symmetry (roller) walls on the four sides: nodes on a wall keep no velocity
+// and no acceleration normal to it, tangential motion is free. A ghost node k
+// cells beyond a wall takes the mirror image of the node k cells inside: the
+// tangential components equal, the normal component negated. In r-z the wall
+// r = 0 is the axis and the same mirror is the axisymmetry condition. The
+// x-walls are mirrored first over all rows, then the y-walls over all columns,
+// so corner ghosts mirror in both.
+inline void apply_walls(const GridGeometry& grid, GridFields& g) {
+  const int nx = grid.nodes_x(), ny = grid.nodes_y(), ghost = grid.ghost_layers;
+  const int x_walls[2] = {ghost, nx - 1 - ghost}, y_walls[2] = {ghost, ny - 1 - ghost};
+  auto mirror = [&g](int from, int to, int normal) {
+    g.velocity[to] = g.velocity[from];
+    g.acceleration[to] = g.acceleration[from];
+    g.velocity[to][normal] = -g.velocity[from][normal];
+    g.acceleration[to][normal] = -g.acceleration[from][normal];
+  };
   for (int j = 0; j < ny; ++j) {
-    for (int i : {0, nx - 1}) {
-      g.velocity[grid.node(i, j)].x() = 0.0;
-      g.acceleration[grid.node(i, j)].x() = 0.0;
+    for (int w : x_walls) {
+      g.velocity[grid.node(w, j)].x() = 0.0;
+      g.acceleration[grid.node(w, j)].x() = 0.0;
+    }
+    for (int k = 1; k <= ghost; ++k) {
+      mirror(grid.node(x_walls[0] + k, j), grid.node(x_walls[0] - k, j), 0);
+      mirror(grid.node(x_walls[1] - k, j), grid.node(x_walls[1] + k, j), 0);
     }
   }
   for (int i = 0; i < nx; ++i) {
-    for (int j : {0, ny - 1}) {
-      g.velocity[grid.node(i, j)].y() = 0.0;
-      g.acceleration[grid.node(i, j)].y() = 0.0;
+    for (int w : y_walls) {
+      g.velocity[grid.node(i, w)].y() = 0.0;
+      g.acceleration[grid.node(i, w)].y() = 0.0;
+    }
+    for (int k = 1; k <= ghost; ++k) {
+      mirror(grid.node(i, y_walls[0] + k), grid.node(i, y_walls[0] - k), 1);
+      mirror(grid.node(i, y_walls[1] - k), grid.node(i, y_walls[1] + k), 1);
     }
   }
 }
@@ -164,10 +191,12 @@ enum ParticleUpdate : unsigned {
   kVelocity = 1u,     // v_p += dt_kick sum_g S_gp a_g (eq. 1.76)
   kPosition = 2u,     // x_p += dt sum_g S_gp v_g^L (eq. 1.76)
   kDeformation = 4u,  // L_p = sum_g v_g (x) G_gp (eq. 1.73); F_p <- (I + dt L_p) F_p
-                      // (eq. 1.74) and V_p = det(F_p) V_p0 (eq. 1.75: the product of
-                      // the increments' determinants, without its round-off drift).
+                      // (eq. 1.74) and V_p = J_p V_p0 (eq. 1.75: the product of the
+                      // increments' determinants, without its round-off drift).
                       // With positions moved by x += dt sum S v (eq. 1.76), I + dt L
                       // is the exact gradient of that map, so F follows the particles.
+                      // In r-z also the hoop rate v_r / r = sum_g <S_g / r> v_gr:
+                      // F_theta <- (1 + dt v_r / r) F_theta, J_p = det(F_p) F_theta.
 };
 
 // Every update reads the grid at the particle's position at the start of the
@@ -180,6 +209,7 @@ void grid_to_particles(const Shape& shape, const GridFields& g, Particles& P, do
   constexpr bool with_velocity = Updates & kVelocity;
   constexpr bool with_position = Updates & kPosition;
   constexpr bool with_deformation = Updates & kDeformation;
+  constexpr bool axisymmetric = Shape::geometry == Geometry::axisymmetric;
   if (position_out == nullptr) position_out = P.position.data();
   const std::size_t n = P.size();
 #pragma omp parallel
@@ -190,15 +220,22 @@ void grid_to_particles(const Shape& shape, const GridFields& g, Particles& P, do
       shape.evaluate(p, s);
       Vec2 acceleration = Vec2::Zero(), velocity = Vec2::Zero();
       Mat2 L = Mat2::Zero();
+      double hoop_rate = 0.0;
       for (int k = 0; k < Shape::stencil_size; ++k) {
         const int i = s.node[k];
         if constexpr (with_velocity) acceleration += s.weight[k] * g.acceleration[i];
         if constexpr (with_position) velocity += s.weight[k] * g.velocity[i];
         if constexpr (with_deformation) L += g.velocity[i] * s.gradient[k].transpose();
+        if constexpr (with_deformation && axisymmetric) hoop_rate += s.hoop[k] * g.velocity[i].x();
       }
       if constexpr (with_deformation) {
         P.deformation_gradient[p] = (Mat2::Identity() + dt * L) * P.deformation_gradient[p];
-        P.volume[p] = determinant(P.deformation_gradient[p]) * P.reference_volume[p];
+        double J = determinant(P.deformation_gradient[p]);
+        if constexpr (axisymmetric) {
+          P.hoop_stretch[p] *= 1.0 + dt * hoop_rate;
+          J *= P.hoop_stretch[p];
+        }
+        P.volume[p] = J * P.reference_volume[p];
       }
       if constexpr (with_velocity) P.velocity[p] += kick * acceleration;
       if constexpr (with_position) position_out[p] = P.position[p] + dt * velocity;
@@ -208,11 +245,20 @@ void grid_to_particles(const Shape& shape, const GridFields& g, Particles& P, do
 
 // ---------------------------------------------------------------- constitutive update
 
-template <class Material>
+template <Geometry G, class Material>
 void update_stress(const Material& material, Particles& P) {
   const std::size_t n = P.size();
+  if constexpr (G == Geometry::axisymmetric) {
 #pragma omp parallel for schedule(static)
-  for (std::size_t p = 0; p < n; ++p) P.stress[p] = material.cauchy_stress(P.deformation_gradient[p]);
+    for (std::size_t p = 0; p < n; ++p) {
+      const Stress<double> sigma = material.stress(P.deformation_gradient[p], P.hoop_stretch[p]);
+      P.stress[p] = sigma.in_plane;
+      P.hoop_stress[p] = sigma.out_of_plane;
+    }
+  } else {
+#pragma omp parallel for schedule(static)
+    for (std::size_t p = 0; p < n; ++p) P.stress[p] = material.cauchy_stress(P.deformation_gradient[p]);
+  }
 }
 
 // ---------------------------------------------------------------- tracers
@@ -244,12 +290,21 @@ struct ParticleScan {
   std::size_t first_unhealthy;    // lowest index of a particle that stops the run, or size()
 };
 
+// Out-of-plane stretch of particle p: F_theta in r-z, 1 in plane strain.
+template <Geometry G>
+double out_of_plane_stretch(const Particles& P, std::size_t p) {
+  if constexpr (G == Geometry::axisymmetric) return P.hoop_stretch[p];
+  return 1.0;
+}
+
 template <class Shape>
 bool particle_healthy(const Shape& shape, const Particles& P, std::size_t p) {
-  const double J = determinant(P.deformation_gradient[p]);
-  return P.position[p].allFinite() && P.velocity[p].allFinite() &&
-         P.deformation_gradient[p].allFinite() && P.stress[p].allFinite() && J > 0.0 &&
-         shape.inside(p);
+  const double F33 = out_of_plane_stretch<Shape::geometry>(P, p);
+  const double J = determinant(P.deformation_gradient[p]) * F33;
+  bool finite = P.position[p].allFinite() && P.velocity[p].allFinite() && P.deformation_gradient[p].allFinite() &&
+                P.stress[p].allFinite();
+  if constexpr (Shape::geometry == Geometry::axisymmetric) finite = finite && std::isfinite(P.hoop_stress[p]);
+  return finite && J > 0.0 && shape.inside(p);
 }
 
 // One pass over particles: the largest signal speed c_p + |v_p|, with c_p the
@@ -267,7 +322,8 @@ ParticleScan scan_particles(const Shape& shape, const Material& material, const 
       continue;
     }
     const double density = P.mass[p] / P.volume[p];
-    const double c = std::sqrt(material.wave_modulus(P.deformation_gradient[p], P.stress[p]) / density);
+    const double F33 = out_of_plane_stretch<Shape::geometry>(P, p);
+    const double c = std::sqrt(material.wave_modulus(P.deformation_gradient[p], F33, P.stress[p]) / density);
     max_speed = std::max(max_speed, c + P.velocity[p].norm());
   }
   return {max_speed, first};

@@ -69,7 +69,7 @@ double wall_margin_in_cells();
 template <>
 double wall_margin_in_cells<LinearShape>() { return 0.0; }
 template <>
-double wall_margin_in_cells<GimpShape>() { return 0.5; }
+double wall_margin_in_cells<GimpShape>() { return 0.25; }  // the half-size h/4: the domain may touch a wall
 template <>
 double wall_margin_in_cells<CpdiShape>() { return 0.25; }
 
@@ -88,8 +88,8 @@ std::vector<Vec2> critical_positions(const GridGeometry& grid) {
       xi.emplace_back(3.0 + ox + hx, 4.0 + ox - hx);
     }
   const double m = wall_margin_in_cells<Shape>();
-  const double lo = m, hi_x = grid.cells_x - m - 1e-9, hi_y = grid.cells_y - m - 1e-9;
-  for (double along : {m, 0.5 * grid.cells_x, 2.3, double(grid.cells_y) - m - 1e-9}) {
+  const double lo = m, hi_x = grid.cells_x - m, hi_y = grid.cells_y - m;
+  for (double along : {m, 0.5 * grid.cells_x, 2.3, double(grid.cells_y) - m}) {
     xi.emplace_back(lo, along);
     xi.emplace_back(lo + 1e-12, along);
     xi.emplace_back(hi_x, along);
@@ -179,24 +179,30 @@ TYPED_TEST(ShapeFunctionTest, PropertiesHoldOnEdgesBreakpointsAndNearWalls) {
   expect_shape_properties<TypeParam>(grid, particles_at(grid, critical_positions<TypeParam>(grid)));
 }
 
-// A particle whose support leaves the grid is not inside; one well inside is.
+// A particle whose support leaves the grid is not inside; one well inside is,
+// and so is one whose support just touches a wall (a body may fill the grid
+// up to its walls).
 TYPED_TEST(ShapeFunctionTest, InsideRejectsSupportBeyondTheGrid) {
   const GridGeometry grid = small_grid();
   const double m = wall_margin_in_cells<TypeParam>();
-  const std::vector<Vec2> xi = {
+  const std::vector<Vec2> inside = {
       {4.1, 3.7},                          // well inside
-      {-0.3, 4.0},                         // centre beyond the left wall
-      {4.0, double(grid.cells_y) + 0.2},   // beyond the top wall
-      {double(grid.cells_x), 4.0},         // on the right wall: its cell does not exist
-      {m - 0.05, 4.0},                     // support crosses the left wall
-      {4.0, double(grid.cells_y) - m},     // the margin on the far side: the test is half-open
+      {4.0, double(grid.cells_y) - m},     // support touching the top wall
+      {m, 4.0},                            // support touching the left wall
+  };
+  const std::vector<Vec2> outside = {
+      {-0.3, 4.0},                              // centre beyond the left wall
+      {4.0, double(grid.cells_y) + 0.2},        // beyond the top wall
+      {double(grid.cells_x) - m + 0.05, 4.0},   // support crosses the right wall
+      {m - 0.05, 4.0},                          // support crosses the left wall
   };
   std::vector<Vec2> x;
-  for (const Vec2& v : xi) x.push_back(grid.origin + grid.h * v);
+  for (const Vec2& v : inside) x.push_back(grid.origin + grid.h * v);
+  for (const Vec2& v : outside) x.push_back(grid.origin + grid.h * v);
   const Particles P = particles_at(grid, x);
   const TypeParam shape = TypeParam::bind(grid, P);
-  EXPECT_TRUE(shape.inside(0));
-  for (std::size_t p = 1; p < P.size(); ++p) EXPECT_FALSE(shape.inside(p)) << "particle " << p;
+  for (std::size_t p = 0; p < inside.size(); ++p) EXPECT_TRUE(shape.inside(p)) << "particle " << p;
+  for (std::size_t p = inside.size(); p < P.size(); ++p) EXPECT_FALSE(shape.inside(p)) << "particle " << p;
 }
 
 // A NaN position is never inside, so a broken particle cannot index the grid.

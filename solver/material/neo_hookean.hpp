@@ -1,12 +1,14 @@
-// Compressible neo-Hookean solid in plane strain,
+// Compressible neo-Hookean solid,
 //   sigma = (lambda ln J / J) I + (mu / J)(F F^T - I)
-// (000_1dbcb8acb6dddab9.txt eq. 2.2). With F_zz = 1 the in-plane block of B is
-// the in-plane F F^T and J is the in-plane determinant.
+// (000_1dbcb8acb6dddab9.txt eq. 2.2), with F = diag(F_inplane, F_33), so
+// B = diag(F F^T, F_33^2) and J = det(F_inplane) F_33.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 
 #include "../tensor.hpp"
+#include "stress.hpp"
 
 namespace mpmvv {
 
@@ -15,14 +17,22 @@ struct NeoHookean {
   double lambda;  // first Lame constant [Pa]
   double mu;      // shear modulus [Pa]
 
-  // Generic over the scalar so that exact solutions can differentiate it.
+  // Generic over the scalar so that manufactured solutions can differentiate it.
+  template <class T>
+  Stress<T> stress(const Eigen::Matrix<T, 2, 2>& F, const T& F33) const {
+    using std::log;
+    using M = Eigen::Matrix<T, 2, 2>;
+    const T J = (F(0, 0) * F(1, 1) - F(0, 1) * F(1, 0)) * F33;
+    const T pressure_like = T(lambda) * log(J) / J;
+    const T shear = T(mu) / J;
+    const M B = F * F.transpose();
+    return {pressure_like * M::Identity() + shear * (B - M::Identity()), pressure_like + shear * (F33 * F33 - T(1.0))};
+  }
+
+  // Plane strain (F_33 = 1): the in-plane block.
   template <class T>
   Eigen::Matrix<T, 2, 2> cauchy_stress(const Eigen::Matrix<T, 2, 2>& F) const {
-    using std::log;
-    const T J = F(0, 0) * F(1, 1) - F(0, 1) * F(1, 0);
-    const Eigen::Matrix<T, 2, 2> B = F * F.transpose();
-    return (T(lambda) * log(J) / J) * Eigen::Matrix<T, 2, 2>::Identity() +
-           (T(mu) / J) * (B - Eigen::Matrix<T, 2, 2>::Identity());
+    return stress(F, T(1.0)).in_plane;
   }
 
   // Small-strain P-wave modulus lambda + 2 mu.
@@ -34,11 +44,12 @@ struct NeoHookean {
   // geometric term sigma_nn to the acoustic tensor, so
   //   rho c^2 <= (lambda + 2 |mu - lambda ln J|) / J + max(sigma_max, 0).
   // Under the ring's shear of 3 this is four times lambda + 2 mu.
-  double wave_modulus(const Mat2& F, const Mat2& sigma) const {
-    const double J = determinant(F);
+  double wave_modulus(const Mat2& F, double F33, const Mat2& sigma) const {
+    const double J = determinant(F) * F33;
     return (std::abs(lambda) + 2.0 * std::abs(mu - lambda * std::log(J))) / J +
            std::max(largest_principal(sigma), 0.0);
   }
+  double wave_modulus(const Mat2& F, const Mat2& sigma) const { return wave_modulus(F, 1.0, sigma); }
 };
 
 }  // namespace mpmvv

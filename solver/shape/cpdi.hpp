@@ -6,6 +6,13 @@
 //   S_gp = (1/4) sum_c S_g(x_c),
 //   G_gp = (1/4) s_p^-T sum_c (xi_c, eta_c)^T S_g(x_c),   s_p = [r_1 r_2],
 // the 2D form of eq. 1.100 (the mean over the square of dN_c/dxi is xi_c / 4).
+//
+// In r-z the averages carry the weight r = r_p + a xi + b eta over the domain
+// (a, b the radial components of r_1, r_2); integrating the corner functions
+// exactly:
+//   S_gp  = sum_c (1/4)(1 + (a xi_c + b eta_c) / (3 r_p)) S_g(x_c),
+//   G_gp  = s_p^-T sum_c ((xi_c/4)(1 + b eta_c / (3 r_p)), (eta_c/4)(1 + a xi_c / (3 r_p))) S_g(x_c),
+//   <S/r> = (1 / (4 r_p)) sum_c S_g(x_c).
 #pragma once
 
 #include <cstddef>
@@ -16,9 +23,12 @@
 
 namespace mpmvv {
 
-struct CpdiShape {
+template <Geometry G>
+struct CpdiShapeT {
   static constexpr int stencil_size = 16;  // four nodes for each of four corners
   static constexpr const char* name = "cpdi";
+  static constexpr Geometry geometry = G;
+  static constexpr bool reads_deformation_gradient = true;
 
   // Natural coordinates of the corners, counter-clockwise (eq. 1.99 in 2D).
   static constexpr double corner_xi[4] = {-1.0, 1.0, 1.0, -1.0};
@@ -29,13 +39,11 @@ struct CpdiShape {
   const Mat2* deformation_gradient;
   const Vec2* half_size;
 
-  static constexpr bool reads_deformation_gradient = true;
-
   // The domains span F_p diag(l_p); `deformation_gradient` may point to a copy
   // of F taken at the start of a step, so that every transfer of the step uses
   // the same domains.
-  static CpdiShape bind(const GridGeometry& grid, const Particles& particles,
-                        const Mat2* deformation_gradient = nullptr) {
+  static CpdiShapeT bind(const GridGeometry& grid, const Particles& particles,
+                         const Mat2* deformation_gradient = nullptr) {
     return {&grid, particles.position.data(),
             deformation_gradient ? deformation_gradient : particles.deformation_gradient.data(),
             particles.half_size.data()};
@@ -55,28 +63,46 @@ struct CpdiShape {
 
   void evaluate(std::size_t p, Stencil<stencil_size>& st) const {
     const Mat2 s = domain(p);
-    // (1/4) s_p^-T written out: s^-T = [[s11, -s10], [-s01, s00]] / det s.
-    const double quarter_inv_det = 0.25 / determinant(s);
+    // s^-T = [[s11, -s10], [-s01, s00]] / det s.
+    const double inv_det = 1.0 / determinant(s);
+    double weight_r = 0.0, weight_a = 0.0, weight_b = 0.0;
+    if constexpr (G == Geometry::axisymmetric) {
+      weight_r = 1.0 / (3.0 * position[p].x());
+      weight_a = s(0, 0) * weight_r;
+      weight_b = s(0, 1) * weight_r;
+    }
     for (int c = 0; c < 4; ++c) {
       const double xi = corner_xi[c], eta = corner_eta[c];
-      const Vec2 corner_gradient = quarter_inv_det * Vec2(s(1, 1) * xi - s(1, 0) * eta, s(0, 0) * eta - s(0, 1) * xi);
+      double corner_weight = 0.25, gxi = 0.25 * xi, geta = 0.25 * eta;
+      if constexpr (G == Geometry::axisymmetric) {
+        corner_weight *= 1.0 + weight_a * xi + weight_b * eta;
+        gxi *= 1.0 + weight_b * eta;
+        geta *= 1.0 + weight_a * xi;
+      }
+      const Vec2 corner_gradient = inv_det * Vec2(s(1, 1) * gxi - s(1, 0) * geta, s(0, 0) * geta - s(0, 1) * gxi);
       int* node = st.node + 4 * c;
       double* w = st.weight + 4 * c;
       bilinear_cell_weights(*grid, corner(p, s, c), node, w);
       for (int k = 0; k < 4; ++k) {
         st.gradient[4 * c + k] = corner_gradient * w[k];
-        w[k] *= 0.25;
+        if constexpr (G == Geometry::axisymmetric) st.hoop[4 * c + k] = 0.75 * weight_r * w[k];
+        w[k] *= corner_weight;
       }
     }
   }
 
-  // Every corner of the domain lies in a cell of the grid.
+  // Every corner of the domain lies in the grid (in r-z: r >= 0, off the axis
+  // at the centre).
   bool inside(std::size_t p) const {
+    if constexpr (G == Geometry::axisymmetric)
+      if (!(position[p].x() > 0.0)) return false;
     const Mat2 s = domain(p);
     for (int c = 0; c < 4; ++c)
       if (!inside_cells(*grid, grid_coordinate(*grid, corner(p, s, c)))) return false;
     return true;
   }
 };
+
+using CpdiShape = CpdiShapeT<Geometry::plane_strain>;
 
 }  // namespace mpmvv

@@ -3,6 +3,12 @@
 // 2D (002_c3305cb8b1bc1490.txt sections 1.6.2-1.6.3). The size is not convected
 // with F ("UGIMP"); eq. 1.91 holds for l_p <= h/2, which one or more particles
 // per cell per direction guarantees.
+//
+// In r-z the averages over the particle carry the weight r (eq. 1.85 with
+// r dA): along r,
+//   S_r = int S r' dr' / (2 l r_p),  G_r = int S' r' dr' / (2 l r_p),
+//   <S / r>_r = int S dr' / (2 l r_p),
+// in closed form below; along z the plain eqs. 1.91-1.92.
 #pragma once
 
 #include <cstddef>
@@ -32,48 +38,100 @@ inline GimpWeight1D gimp_weight_1d(double d, double h, double l) {
   return {s * s / (4.0 * h * l), -s / (2.0 * h * l)};
 }
 
-struct GimpShape {
+// The hat S(u) = max(0, 1 - |u| / h) and its first moment
+// M(u) = int_{-h}^{u} S(s) s ds (zero outside [-h, h]).
+inline double hat(double u, double h) { return std::max(0.0, 1.0 - std::abs(u) / h); }
+inline double hat_first_moment(double u, double h) {
+  if (u <= -h || u >= h) return 0.0;
+  const double cubic = u * u * u / (3.0 * h);
+  return 0.5 * u * u + (u <= 0.0 ? cubic : -cubic) - h * h / 6.0;
+}
+
+// The r-weighted 1D factors of a node at x_g for a particle at r with half-size l.
+struct GimpRadial1D {
+  double weight;      // int S r' dr' / (2 l r)
+  double derivative;  // int S' r' dr' / (2 l r)
+  double hoop;        // int S dr' / (2 l r)
+};
+
+inline GimpRadial1D gimp_radial_1d(double r, double x_g, double h, double l) {
+  const double d = r - x_g;
+  const GimpWeight1D plain = gimp_weight_1d(d, h, l);
+  // int S(u) (x_g + u) du over u in [d - l, d + l].
+  const double moment = hat_first_moment(d + l, h) - hat_first_moment(d - l, h);
+  const double inv_r = 1.0 / r;
+  return {(x_g * plain.weight + moment / (2.0 * l)) * inv_r,
+          // Integration by parts: [S r']_{r-l}^{r+l} - int S dr'.
+          (hat(d + l, h) * (r + l) - hat(d - l, h) * (r - l)) / (2.0 * l) * inv_r - plain.weight * inv_r,
+          plain.weight * inv_r};
+}
+
+template <Geometry G>
+struct GimpShapeT {
   static constexpr int stencil_size = 9;
   static constexpr const char* name = "gimp";
+  static constexpr Geometry geometry = G;
+  static constexpr bool reads_deformation_gradient = false;
 
   const GridGeometry* grid;
   const Vec2* position;
   const Vec2* half_size;
 
-  static constexpr bool reads_deformation_gradient = false;
-
-  static GimpShape bind(const GridGeometry& grid, const Particles& particles, const Mat2* = nullptr) {
+  static GimpShapeT bind(const GridGeometry& grid, const Particles& particles, const Mat2* = nullptr) {
     return {&grid, particles.position.data(), particles.half_size.data()};
   }
 
   // With l_p <= h/2 a particle reaches the node nearest to it and one on each
-  // side, three per direction.
+  // side, three per direction. A node beyond the grid carries zero weight when
+  // the particle's domain lies inside the grid (inside()); it is skipped with a
+  // zero weight on a node that exists.
   void evaluate(std::size_t p, Stencil<stencil_size>& s) const {
     const GridGeometry& g = *grid;
-    const Vec2 xi = grid_coordinate(g, position[p]);
+    const Vec2 x = position[p];
+    const Vec2 xi = grid_coordinate(g, x);
     const int i0 = static_cast<int>(std::floor(xi.x() + 0.5)) - 1;
     const int j0 = static_cast<int>(std::floor(xi.y() + 0.5)) - 1;
-    GimpWeight1D wx[3], wy[3];
+    double wx[3], dx[3], hx[3], wy[3], dy[3];
+    int ix[3], iy[3];
     for (int a = 0; a < 3; ++a) {
-      wx[a] = gimp_weight_1d((xi.x() - (i0 + a)) * g.h, g.h, half_size[p].x());
-      wy[a] = gimp_weight_1d((xi.y() - (j0 + a)) * g.h, g.h, half_size[p].y());
+      const int i = i0 + a, j = j0 + a;
+      const bool in_x = i >= 0 && i <= g.cells_x, in_y = j >= 0 && j <= g.cells_y;
+      ix[a] = std::clamp(i, 0, g.cells_x);
+      iy[a] = std::clamp(j, 0, g.cells_y);
+      const double node_x = g.origin.x() + i * g.h;
+      if constexpr (G == Geometry::axisymmetric) {
+        const GimpRadial1D r = gimp_radial_1d(x.x(), node_x, g.h, half_size[p].x());
+        wx[a] = in_x ? r.weight : 0.0;
+        dx[a] = in_x ? r.derivative : 0.0;
+        hx[a] = in_x ? r.hoop : 0.0;
+      } else {
+        const GimpWeight1D w = gimp_weight_1d(x.x() - node_x, g.h, half_size[p].x());
+        wx[a] = in_x ? w.weight : 0.0;
+        dx[a] = in_x ? w.derivative : 0.0;
+      }
+      const GimpWeight1D w = gimp_weight_1d((xi.y() - j) * g.h, g.h, half_size[p].y());
+      wy[a] = in_y ? w.weight : 0.0;
+      dy[a] = in_y ? w.derivative : 0.0;
     }
     int k = 0;
     for (int b = 0; b < 3; ++b) {
       for (int a = 0; a < 3; ++a, ++k) {
-        s.node[k] = g.node(i0 + a, j0 + b);
-        s.weight[k] = wx[a].weight * wy[b].weight;
-        s.gradient[k] = Vec2(wx[a].derivative * wy[b].weight, wx[a].weight * wy[b].derivative);
+        s.node[k] = g.node(ix[a], iy[b]);
+        s.weight[k] = wx[a] * wy[b];
+        s.gradient[k] = Vec2(dx[a] * wy[b], wx[a] * dy[b]);
+        if constexpr (G == Geometry::axisymmetric) s.hoop[k] = hx[a] * wy[b];
       }
     }
   }
 
-  // All three nodes along each axis exist.
+  // The particle's domain lies inside the grid.
   bool inside(std::size_t p) const {
-    const Vec2 xi = grid_coordinate(*grid, position[p]);
-    const double ix = std::floor(xi.x() + 0.5), iy = std::floor(xi.y() + 0.5);
-    return ix >= 1.0 && ix <= grid->cells_x - 1 && iy >= 1.0 && iy <= grid->cells_y - 1;
+    const Vec2 lo = position[p] - half_size[p], hi = position[p] + half_size[p];
+    const Vec2 top = grid->upper();
+    return lo.x() >= grid->origin.x() && lo.y() >= grid->origin.y() && hi.x() <= top.x() && hi.y() <= top.y();
   }
 };
+
+using GimpShape = GimpShapeT<Geometry::plane_strain>;
 
 }  // namespace mpmvv

@@ -1,6 +1,7 @@
 // Standard MPM: the particle is a Dirac delta (eq. 1.88), so the effective
 // shape function is the bilinear hat of its cell, eqs. 1.86-1.87, with the
 // piecewise-constant gradient of eq. 1.89 (002_c3305cb8b1bc1490.txt section 1.6.1).
+// In r-z the point quadrature gives <S_g / r> = S_g(x_p) / r_p.
 #pragma once
 
 #include <cstddef>
@@ -10,20 +11,20 @@
 
 namespace mpmvv {
 
-// Bilinear hat weights and gradients of the four nodes of the cell holding x.
-// Shared by linear MPM, by CPDI at each domain corner, and by massless tracers.
-inline void bilinear_cell(const GridGeometry& grid, const Vec2& x, int* node, double* weight,
-                          Vec2* gradient) {
+// Bilinear hat weights and gradients of the four nodes of the cell holding x
+// (x inside the grid). Shared by linear MPM and by massless tracers.
+inline void bilinear_cell(const GridGeometry& grid, const Vec2& x, int* node, double* weight, Vec2* gradient) {
   const Vec2 xi = grid_coordinate(grid, x);
-  const int i = static_cast<int>(std::floor(xi.x()));
-  const int j = static_cast<int>(std::floor(xi.y()));
-  const double fx = xi.x() - i, fy = xi.y() - j;  // in [0, 1)
+  const int i = cell_index(xi.x(), grid.cells_x);
+  const int j = cell_index(xi.y(), grid.cells_y);
+  const double fx = xi.x() - i, fy = xi.y() - j;  // in [0, 1]
   const double gx = 1.0 - fx, gy = 1.0 - fy;
   const double inv_h = 1.0 / grid.h;
-  node[0] = grid.node(i, j);
-  node[1] = grid.node(i + 1, j);
-  node[2] = grid.node(i, j + 1);
-  node[3] = grid.node(i + 1, j + 1);
+  const int n00 = grid.node(i, j);
+  node[0] = n00;
+  node[1] = n00 + 1;
+  node[2] = n00 + grid.nodes_x();
+  node[3] = n00 + grid.nodes_x() + 1;
   weight[0] = gx * gy;
   weight[1] = fx * gy;
   weight[2] = gx * fy;
@@ -34,13 +35,11 @@ inline void bilinear_cell(const GridGeometry& grid, const Vec2& x, int* node, do
   gradient[3] = Vec2(fy, fx) * inv_h;
 }
 
-// Bilinear hat weights alone, for callers that form their own gradients. The
-// point must lie inside the grid (the health scan guarantees it before every
-// step), so truncation toward zero is the floor.
+// Bilinear hat weights alone, for callers that form their own gradients.
 inline void bilinear_cell_weights(const GridGeometry& grid, const Vec2& x, int* node, double* weight) {
   const Vec2 xi = grid_coordinate(grid, x);
-  const int i = static_cast<int>(xi.x());
-  const int j = static_cast<int>(xi.y());
+  const int i = cell_index(xi.x(), grid.cells_x);
+  const int j = cell_index(xi.y(), grid.cells_y);
   const double fx = xi.x() - i, fy = xi.y() - j;
   const double gx = 1.0 - fx, gy = 1.0 - fy;
   const int n00 = grid.node(i, j);
@@ -54,25 +53,36 @@ inline void bilinear_cell_weights(const GridGeometry& grid, const Vec2& x, int* 
   weight[3] = fx * fy;
 }
 
-struct LinearShape {
+template <Geometry G>
+struct LinearShapeT {
   static constexpr int stencil_size = 4;
   static constexpr const char* name = "linear";
+  static constexpr Geometry geometry = G;
+  static constexpr bool reads_deformation_gradient = false;
 
   const GridGeometry* grid;
   const Vec2* position;
 
-  static constexpr bool reads_deformation_gradient = false;
-
-  static LinearShape bind(const GridGeometry& grid, const Particles& particles, const Mat2* = nullptr) {
+  static LinearShapeT bind(const GridGeometry& grid, const Particles& particles, const Mat2* = nullptr) {
     return {&grid, particles.position.data()};
   }
 
   void evaluate(std::size_t p, Stencil<stencil_size>& s) const {
     bilinear_cell(*grid, position[p], s.node, s.weight, s.gradient);
+    if constexpr (G == Geometry::axisymmetric) {
+      const double inv_r = 1.0 / position[p].x();
+      for (int k = 0; k < stencil_size; ++k) s.hoop[k] = s.weight[k] * inv_r;
+    }
   }
 
-  // The particle's cell lies inside the grid.
-  bool inside(std::size_t p) const { return inside_cells(*grid, grid_coordinate(*grid, position[p])); }
+  // The particle's cell lies inside the grid (and, in r-z, off the axis).
+  bool inside(std::size_t p) const {
+    if constexpr (G == Geometry::axisymmetric)
+      if (!(position[p].x() > 0.0)) return false;
+    return inside_cells(*grid, grid_coordinate(*grid, position[p]));
+  }
 };
+
+using LinearShape = LinearShapeT<Geometry::plane_strain>;
 
 }  // namespace mpmvv

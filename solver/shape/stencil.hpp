@@ -4,19 +4,26 @@
 // `evaluate`, so particle-to-grid and grid-to-particle share one computation.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 
+#include "../geometry.hpp"
 #include "../grid.hpp"
 #include "../tensor.hpp"
 
 namespace mpmvv {
 
+// In r-z runs `hoop` holds <S_g / r>_p, the r-weighted average of S_g / r over
+// the particle, which carries the hoop stress to the radial force and the
+// radial velocity to the hoop rate (the same weight both ways, so the hoop
+// work is conserved). Plane-strain shapes leave it unset.
 template <int N>
 struct Stencil {
   static constexpr int size = N;
   int node[N];
   double weight[N];
   Vec2 gradient[N];
+  double hoop[N];
 };
 
 // Grid coordinate of a point, in cells from the domain's lower-left corner.
@@ -24,10 +31,15 @@ inline Vec2 grid_coordinate(const GridGeometry& grid, const Vec2& x) {
   return (x - grid.origin) / grid.h;
 }
 
-// True when the point lies in the half-open domain [0, cells) along both axes,
-// so that the two nodes of its cell exist. NaN coordinates fail the test.
+// True when the point lies in the closed domain [0, cells] along both axes,
+// so that the nodes of its cell exist (a point on the upper wall belongs to
+// the last cell). NaN coordinates fail the test.
 inline bool inside_cells(const GridGeometry& grid, const Vec2& xi) {
-  return xi.x() >= 0.0 && xi.x() < grid.cells_x && xi.y() >= 0.0 && xi.y() < grid.cells_y;
+  return xi.x() >= 0.0 && xi.x() <= grid.cells_x && xi.y() >= 0.0 && xi.y() <= grid.cells_y;
 }
+
+// Index of the cell holding grid coordinate xi >= 0 along an axis of n cells;
+// the upper wall belongs to the last cell.
+inline int cell_index(double xi, int n) { return std::min(static_cast<int>(xi), n - 1); }
 
 }  // namespace mpmvv

@@ -165,7 +165,13 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
   if (!request.quiet)
     fmt::print(err, "mpmvv run {} -> {} ({} threads)\nconfiguration:{}\n", request.scene_file, output, max_threads(),
                compact(config));
-  const RunOutcome o = scene->run(request.quiet ? ProgressSink{} : progress_printer(err));
+  RunOutcome o;
+  try {
+    o = scene->run(request.quiet ? ProgressSink{} : progress_printer(err));
+  } catch (const ConfigError& e) {
+    fmt::print(err, "mpmvv run: {}\n", e.what());
+    return 2;
+  }
 
   // Write next to the target and rename: a killed run never leaves a file that
   // looks whole.

@@ -1,5 +1,7 @@
 #include "scene.hpp"
 
+#include "mms_scene.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <ostream>
@@ -10,13 +12,14 @@
 
 namespace mpmvv::app {
 
-std::unique_ptr<SceneCase> build_ring_case(const Config& config);
-std::vector<KeySpec> ring_keys();
-
+// Every manufactured problem is a scene of its own name.
 const std::vector<SceneType>& scene_types() {
-  static const std::vector<SceneType> types = {
-      {"ring", "ring MMS under a manufactured body force (PROBLEMS.md section 1)", ring_keys, build_ring_case},
-  };
+  static const std::vector<SceneType> types = [] {
+    std::vector<SceneType> t;
+    for (const MmsProblem& p : mms_problems())
+      t.push_back({p.name, p.summary, p.keys, [&p](const Config& c) { return build_mms_case(c, p); }});
+    return t;
+  }();
   return types;
 }
 

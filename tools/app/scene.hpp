@@ -3,6 +3,7 @@
 // absent from its run.
 #pragma once
 
+#include <functional>
 #include <iosfwd>
 #include <memory>
 #include <optional>
@@ -47,7 +48,7 @@ struct SceneType {
   std::vector<KeySpec> (*keys)();
   // Checks the rules that tie keys together and builds the case; throws
   // ConfigError naming the key.
-  std::unique_ptr<SceneCase> (*build)(const Config&);
+  std::function<std::unique_ptr<SceneCase>(const Config&)> build;
 };
 
 const std::vector<SceneType>& scene_types();

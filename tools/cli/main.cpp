@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "tools/app/config.hpp"
+#include "tools/app/mms_command.hpp"
 #include "tools/app/run_case.hpp"
 
 namespace {
@@ -42,6 +43,31 @@ int main(int argc, char** argv) {
 
   app.add_subcommand("scenes", "List the scenes and the keys each accepts.");
 
+  CLI::App* mms_cmd = app.add_subcommand("mms", "Manufactured solutions: list them, evaluate one, check its body force.");
+  mms_cmd->require_subcommand(1);
+  mms_cmd->add_subcommand("list", "The manufactured solutions and their parameters.");
+  mpmvv::app::MmsEvalRequest eval;
+  CLI::App* eval_cmd = mms_cmd->add_subcommand(
+      "eval", "Exact fields and body force of a solution at one reference point.\nExit status: 0, or 2 on bad input.");
+  eval_cmd->add_option("name", eval.name, "solution name (mpmvv mms list)")->required();
+  eval_cmd->add_option("--at", eval.at, "reference point X,Y (R,Z in r-z)")->required()->delimiter(',')->expected(2);
+  eval_cmd->add_option("--time", eval.time, "time t [s]")->required();
+  eval_cmd->add_option("--set", eval.overrides, "override a parameter: --set amplitude=1 (repeatable)")
+      ->allow_extra_args(false)
+      ->type_name("KEY=VALUE");
+  eval_cmd->add_flag("--json", eval.json, "one JSON object instead of text");
+  mpmvv::app::MmsCheckRequest check;
+  CLI::App* check_cmd = mms_cmd->add_subcommand(
+      "check", "Residual a - Div P / rho_0 - b at random points, by finite differences independent of the "
+               "derived force.\nExit status: 0 within tolerance, 1 above, 2 bad input.");
+  check_cmd->add_option("name", check.name, "solution name (mpmvv mms list)")->required();
+  check_cmd->add_option("--points", check.points, "random points")->check(CLI::Range(1, 10000000));
+  check_cmd->add_option("--tolerance", check.tolerance, "largest allowed relative residual")->check(CLI::PositiveNumber);
+  check_cmd->add_option("--seed", check.seed, "random seed");
+  check_cmd->add_option("--set", check.overrides, "override a parameter (repeatable)")
+      ->allow_extra_args(false)
+      ->type_name("KEY=VALUE");
+
   if (argc > 1 && argv[1][0] != '-') {
     bool known = false;
     std::string commands;
@@ -70,6 +96,14 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  if (mms_cmd->parsed()) {
+    if (mms_cmd->got_subcommand("list")) {
+      std::cout << mpmvv::app::mms_list();
+      return 0;
+    }
+    if (eval_cmd->parsed()) return mpmvv::app::mms_eval(eval, std::cout, std::cerr);
+    if (check_cmd->parsed()) return mpmvv::app::mms_check(check, std::cout, std::cerr);
+  }
   if (app.got_subcommand("scenes")) {
     std::cout << mpmvv::app::describe_scenes();
     return 0;

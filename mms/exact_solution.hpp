@@ -1,0 +1,77 @@
+// A manufactured solution behind one interface, so that scenes and the
+// command line choose motion and material at run time. Calls are per point
+// (for probes, checks and people) or per particle array (the body-force stage:
+// one virtual call per step, the loop inside).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "manufactured.hpp"
+#include "solver/model.hpp"
+
+namespace mpmvv::mms {
+
+class ExactSolution {
+ public:
+  virtual ~ExactSolution() = default;
+  virtual Geometry geometry() const = 0;
+  virtual double density() const = 0;
+  virtual Vec2 position(const Vec2& X, double t) const = 0;
+  virtual ExactFields fields(const Vec2& X, double t) const = 0;
+  virtual Vec2 body_force(const Vec2& X, double t) const = 0;
+  // b at every reference position (threads over the array).
+  virtual void body_forces(double t, const std::vector<Vec2>& X, std::vector<Vec2>& b) const = 0;
+  virtual ResidualCheck check(const Vec2& X, double t) const = 0;
+};
+
+template <class Motion, class Material>
+class ManufacturedSolution final : public ExactSolution {
+ public:
+  ManufacturedSolution(Motion motion, Material material, double density, Geometry geometry)
+      : m_(std::move(motion), material, density, geometry) {}
+
+  Geometry geometry() const override { return m_.geometry(); }
+  double density() const override { return m_.density(); }
+  Vec2 position(const Vec2& X, double t) const override { return m_.position(X, t); }
+  ExactFields fields(const Vec2& X, double t) const override { return m_.fields(X, t); }
+  Vec2 body_force(const Vec2& X, double t) const override { return m_.body_force(X, t); }
+  void body_forces(double t, const std::vector<Vec2>& X, std::vector<Vec2>& b) const override {
+    const std::size_t n = X.size();
+#pragma omp parallel for schedule(static)
+    for (std::size_t p = 0; p < n; ++p) b[p] = m_.body_force(X[p], t);
+  }
+  ResidualCheck check(const Vec2& X, double t) const override { return m_.check(X, t); }
+  const Manufactured<Motion, Material>& manufactured() const { return m_; }
+
+ private:
+  Manufactured<Motion, Material> m_;
+};
+
+// The solution of `motion` in whichever material the scene chose.
+template <class Motion>
+std::shared_ptr<const ExactSolution> make_solution(const Motion& motion, const MaterialModel& material,
+                                                   double density, Geometry geometry) {
+  return std::visit(
+      [&](const auto& m) -> std::shared_ptr<const ExactSolution> {
+        using Material = std::decay_t<decltype(m)>;
+        return std::make_shared<ManufacturedSolution<Motion, Material>>(motion, m, density, geometry);
+      },
+      material);
+}
+
+// The derived body force as the solver's body-force stage.
+class DerivedBodyForce final : public BodyForce {
+ public:
+  explicit DerivedBodyForce(std::shared_ptr<const ExactSolution> solution) : solution_(std::move(solution)) {}
+  void evaluate(double t, const Particles& particles, std::vector<Vec2>& b) const override {
+    solution_->body_forces(t, particles.reference_position, b);
+  }
+
+ private:
+  std::shared_ptr<const ExactSolution> solution_;
+};
+
+}  // namespace mpmvv::mms

@@ -1,0 +1,236 @@
+// A manufactured solution is one definition: a motion x = phi(X, t), written
+// once and generic over its scalar type, and a material. Everything else is
+// derived here:
+//   F = dphi/dX and dF/dX      forward-mode AD, X a second-order jet
+//   v, a = dphi/dt, d2phi/dt2  forward-mode AD, t a second-order jet
+//   sigma, P = J sigma F^-T     the material, with jets carrying dP/dX
+//   b = a - Div P / rho_0       balance of momentum solved for the force
+// in plane strain (Cartesian X = (X, Y)) or in r-z (X = (R, Z), hoop stretch
+// F_33 = r / R, and the geometric terms of the divergence in cylindrical
+// coordinates:
+//   (Div P)_r = dP_rR/dR + dP_rZ/dZ + (P_rR - P_thetatheta) / R,
+//   (Div P)_z = dP_zR/dR + dP_zZ/dZ + P_zR / R).
+//
+// A Motion provides
+//   template <class S> Eigen::Matrix<S, 2, 1> position(const Eigen::Matrix<S, 2, 1>& X, const S& t) const;
+//   double length_scale() const;  double time_scale() const;   (for finite-difference checks)
+// A Material provides stress(F, F_33) generic over the scalar (solver/material/).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "jet.hpp"
+#include "solver/geometry.hpp"
+#include "solver/material/stress.hpp"
+#include "solver/tensor.hpp"
+
+namespace mpmvv::mms {
+
+
+// Everything the exact solution says at one material point and time.
+struct ExactFields {
+  Vec2 position, displacement, velocity, acceleration;
+  Mat2 deformation_gradient;  // in-plane block of F
+  double hoop_stretch;        // F_33: 1 in plane strain, r / R in r-z
+  double J;
+  Mat2 cauchy_stress;         // in-plane block of sigma
+  double cauchy_stress_33;    // sigma_zz (plane strain) or sigma_theta (r-z)
+  Mat2 first_piola;           // in-plane block of P = J sigma F^-T
+  double first_piola_33;
+  Vec2 body_force;            // b = a - Div P / rho_0
+};
+
+// Balance of momentum checked independently of the automatic differentiation:
+// a from a finite difference of the motion in time, F from finite differences
+// in X, Div P from finite differences of P(F) in X.
+struct ResidualCheck {
+  Vec2 residual;   // a - Div P / rho_0 - b
+  double scale;    // |a| + |Div P / rho_0| + |b|
+  double relative() const { return residual.norm() / std::max(scale, 1e-300); }
+};
+
+template <class Motion, class Material>
+class Manufactured {
+ public:
+  Manufactured(Motion motion, Material material, double density, Geometry geometry)
+      : motion_(std::move(motion)), material_(material), density_(density), geometry_(geometry) {}
+
+  const Motion& motion() const { return motion_; }
+  const Material& material() const { return material_; }
+  double density() const { return density_; }
+  Geometry geometry() const { return geometry_; }
+
+  Vec2 position(const Vec2& X, double t) const { return motion_.position(X, t); }
+
+  ExactFields fields(const Vec2& X, double t) const {
+    ExactFields f;
+    const Temporal time = temporal(X, t);
+    f.position = time.position;
+    f.displacement = time.position - X;
+    f.velocity = time.velocity;
+    f.acceleration = time.acceleration;
+    const Spatial space = spatial(X, t);
+    f.deformation_gradient = value(space.F);
+    f.hoop_stretch = space.F33.v;
+    f.J = determinant(f.deformation_gradient) * f.hoop_stretch;
+    f.cauchy_stress = value(space.sigma.in_plane);
+    f.cauchy_stress_33 = space.sigma.out_of_plane.v;
+    f.first_piola = value(space.P);
+    f.first_piola_33 = space.P33.v;
+    f.body_force = f.acceleration - divergence(space, X) / density_;
+    return f;
+  }
+
+  Vec2 body_force(const Vec2& X, double t) const {
+    return temporal(X, t).acceleration - divergence(spatial(X, t), X) / density_;
+  }
+
+  // The residual of the balance of momentum at X, t by finite differences only
+  // (sixth-order central differences with steps 1e-3 of the motion's length
+  // and time scales: truncation falls below the round-off of the nested
+  // differences), against the derived body force.
+  ResidualCheck check(const Vec2& X, double t) const {
+    const double dt = 1e-3 * motion_.time_scale();
+    const double dx = 1e-3 * motion_.length_scale();
+    auto x = [&](double time) { return motion_.position(X, time); };
+    const Vec2 a = (2.0 * x(t - 3 * dt) - 27.0 * x(t - 2 * dt) + 270.0 * x(t - dt) - 490.0 * x(t) + 270.0 * x(t + dt) -
+                    27.0 * x(t + 2 * dt) + 2.0 * x(t + 3 * dt)) /
+                   (180.0 * dt * dt);
+    Vec2 div = Vec2::Zero();
+    Mat2 P0 = Mat2::Zero();
+    double P0_33 = 0.0;
+    for (int J = 0; J < 2; ++J) {
+      Vec2 e = Vec2::Zero();
+      e[J] = dx;
+      Mat2 p[7];
+      for (int k = -3; k <= 3; ++k) {
+        const Vec2 Xk = X + double(k) * e;
+        const Mat2 F = finite_difference_F(Xk, t, dx);
+        const double F33 = hoop_stretch(motion_.position(Xk, t), Xk);
+        const Stress<double> s = material_.stress(F, F33);
+        const double Jdet = determinant(F) * F33;
+        p[k + 3] = Jdet * s.in_plane * inverse(F).transpose();
+        if (k == 0) {
+          P0 = p[3];
+          P0_33 = Jdet * s.out_of_plane / F33;
+        }
+      }
+      div += sixth_order_derivative(p, dx).col(J);
+    }
+    if (geometry_ == Geometry::axisymmetric) {
+      div.x() += (P0(0, 0) - P0_33) / X.x();
+      div.y() += P0(1, 0) / X.x();
+    }
+    div /= density_;
+    const Vec2 b = body_force(X, t);
+    return {a - div - b, a.norm() + div.norm() + b.norm()};
+  }
+
+ private:
+  using Jet1 = Jet<double, 1>;
+  using Jet2 = Jet<double, 2>;
+  using TimeJet = Jet<Jet1, 1>;   // t with first and second derivative
+  using SpaceJet = Jet<Jet2, 2>;  // X with gradient and Hessian
+  using Vec2J = Eigen::Matrix<Jet2, 2, 1>;
+  using Mat2J = Eigen::Matrix<Jet2, 2, 2>;
+
+  struct Temporal {
+    Vec2 position, velocity, acceleration;
+  };
+  // F, F_33 and the stresses at X, each carrying its derivative along X.
+  struct Spatial {
+    Mat2J F;
+    Jet2 F33;
+    Stress<Jet2> sigma;
+    Mat2J P;
+    Jet2 P33;
+  };
+
+  static Mat2 value(const Mat2J& m) {
+    Mat2 r;
+    for (int i = 0; i < 2; ++i)
+      for (int j = 0; j < 2; ++j) r(i, j) = m(i, j).v;
+    return r;
+  }
+
+  double hoop_stretch(const Vec2& x, const Vec2& X) const {
+    return geometry_ == Geometry::axisymmetric ? x.x() / X.x() : 1.0;
+  }
+
+  Temporal temporal(const Vec2& X, double t) const {
+    const TimeJet time(Jet1::variable(t, 0), {Jet1(1.0)});
+    const Eigen::Matrix<TimeJet, 2, 1> XJ(TimeJet(X.x()), TimeJet(X.y()));
+    const Eigen::Matrix<TimeJet, 2, 1> x = motion_.position(XJ, time);
+    Temporal r;
+    for (int i = 0; i < 2; ++i) {
+      r.position[i] = x[i].v.v;
+      r.velocity[i] = x[i].v.d[0];
+      r.acceleration[i] = x[i].d[0].d[0];
+    }
+    return r;
+  }
+
+  Spatial spatial(const Vec2& X, double t) const {
+    // X_J seeded in the inner jet (for F) and in the outer jet (for dF/dX).
+    Eigen::Matrix<SpaceJet, 2, 1> XJ;
+    for (int J = 0; J < 2; ++J) {
+      std::array<Jet2, 2> outer{};
+      outer[std::size_t(J)] = Jet2(1.0);
+      XJ[J] = SpaceJet(Jet2::variable(X[J], J), outer);
+    }
+    const Eigen::Matrix<SpaceJet, 2, 1> x = motion_.position(XJ, SpaceJet(t));
+    Spatial s;
+    for (int i = 0; i < 2; ++i)
+      for (int K = 0; K < 2; ++K) s.F(i, K) = Jet2(x[i].v.d[K], {x[i].d[0].d[K], x[i].d[1].d[K]});
+    if (geometry_ == Geometry::axisymmetric) {
+      const Jet2 r(x[0].v.v, {x[0].d[0].v, x[0].d[1].v});
+      s.F33 = r / Jet2::variable(X.x(), 0);
+    } else {
+      s.F33 = Jet2(1.0);
+    }
+    s.sigma = material_.stress(s.F, s.F33);
+    const Jet2 J = (s.F(0, 0) * s.F(1, 1) - s.F(0, 1) * s.F(1, 0)) * s.F33;
+    const Jet2 det2 = s.F(0, 0) * s.F(1, 1) - s.F(0, 1) * s.F(1, 0);
+    Mat2J F_inv_t;
+    F_inv_t << s.F(1, 1) / det2, -s.F(1, 0) / det2, -s.F(0, 1) / det2, s.F(0, 0) / det2;
+    s.P = J * s.sigma.in_plane * F_inv_t;
+    s.P33 = J * s.sigma.out_of_plane / s.F33;
+    return s;
+  }
+
+  Vec2 divergence(const Spatial& s, const Vec2& X) const {
+    Vec2 div(s.P(0, 0).d[0] + s.P(0, 1).d[1], s.P(1, 0).d[0] + s.P(1, 1).d[1]);
+    if (geometry_ == Geometry::axisymmetric) {
+      div.x() += (s.P(0, 0).v - s.P33.v) / X.x();
+      div.y() += s.P(1, 0).v / X.x();
+    }
+    return div;
+  }
+
+  // f' from f at -3h .. 3h.
+  template <class T>
+  static T sixth_order_derivative(const T* f, double h) {
+    return (-f[0] + 9.0 * f[1] - 45.0 * f[2] + 45.0 * f[4] - 9.0 * f[5] + f[6]) / (60.0 * h);
+  }
+
+  Mat2 finite_difference_F(const Vec2& X, double t, double dx) const {
+    Mat2 F;
+    for (int K = 0; K < 2; ++K) {
+      Vec2 e = Vec2::Zero();
+      e[K] = dx;
+      Vec2 x[7];
+      for (int k = -3; k <= 3; ++k) x[k + 3] = motion_.position(Vec2(X + double(k) * e), t);
+      F.col(K) = sixth_order_derivative(x, dx);
+    }
+    return F;
+  }
+
+  Motion motion_;
+  Material material_;
+  double density_;
+  Geometry geometry_;
+};
+
+}  // namespace mpmvv::mms

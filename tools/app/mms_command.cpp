@@ -1,0 +1,154 @@
+#include "mms_command.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <ostream>
+#include <random>
+
+#include <fmt/format.h>
+#include <fmt/ostream.h>
+
+#include "mms_scene.hpp"
+
+namespace mpmvv::app {
+
+namespace {
+
+// The problem's configuration with its defaults and the overrides; throws ConfigError.
+const MmsProblem& problem_named(const std::string& name) {
+  const MmsProblem* p = find_mms_problem(name);
+  if (!p) {
+    std::string names;
+    for (const MmsProblem& q : mms_problems()) names += (names.empty() ? "" : ", ") + q.name;
+    throw ConfigError(fmt::format("unknown manufactured solution '{}' (known: {})", name, names));
+  }
+  return *p;
+}
+
+ProblemSetup setup_for(const MmsProblem& problem, const std::vector<std::string>& overrides) {
+  Config config(problem.name, problem.keys());
+  for (const std::string& o : overrides) config.set_from_text(o);
+  return problem.setup(config);
+}
+
+std::string json_vector(const Vec2& v) { return fmt::format("[{:.17g}, {:.17g}]", v.x(), v.y()); }
+std::string json_matrix(const Mat2& m) {
+  return fmt::format("[[{:.17g}, {:.17g}], [{:.17g}, {:.17g}]]", m(0, 0), m(0, 1), m(1, 0), m(1, 1));
+}
+
+}  // namespace
+
+std::string mms_list() {
+  std::string s;
+  for (const MmsProblem& p : mms_problems()) {
+    s += fmt::format("{}: {}\n", p.name, p.summary);
+    for (const KeySpec& k : p.keys()) {
+      // The solver's keys belong to runs, not to the solution.
+      static const char* solver_only[] = {"method", "scheme", "time_integration", "cells", "particles_per_direction",
+                                          "cfl", "end_time", "output_times", "probe_points", "circle_points"};
+      if (std::find(std::begin(solver_only), std::end(solver_only), k.name) != std::end(solver_only)) continue;
+      s += fmt::format("  {:<16} default {:<14} {}\n", k.name, format_value(k.default_value), k.help);
+    }
+  }
+  return s;
+}
+
+int mms_eval(const MmsEvalRequest& r, std::ostream& out, std::ostream& err) {
+  ProblemSetup setup;
+  try {
+    const MmsProblem& problem = problem_named(r.name);
+    if (r.at.size() != 2) throw ConfigError("--at takes two coordinates, X,Y (R,Z in r-z)");
+    setup = setup_for(problem, r.overrides);
+    const Vec2 X(r.at[0], r.at[1]);
+    if (!setup.contains(X))
+      throw ConfigError(fmt::format("--at {},{}: the point lies outside the body of '{}'", X.x(), X.y(), r.name));
+    if (setup.geometry == Geometry::axisymmetric && !(X.x() > 0.0))
+      throw ConfigError(fmt::format("--at {},{}: r-z solutions are evaluated off the axis (R > 0)", X.x(), X.y()));
+  } catch (const ConfigError& e) {
+    fmt::print(err, "mpmvv mms eval: {}\n", e.what());
+    return 2;
+  }
+  const Vec2 X(r.at[0], r.at[1]);
+  const mms::ExactFields f = setup.solution->fields(X, r.time);
+  const bool rz = setup.geometry == Geometry::axisymmetric;
+  if (r.json) {
+    fmt::print(out,
+               "{{\"solution\": \"{}\", \"geometry\": \"{}\", \"reference_position\": {}, \"time\": {:.17g}, "
+               "\"position\": {}, \"displacement\": {}, \"velocity\": {}, \"acceleration\": {}, \"F\": {}, "
+               "\"F33\": {:.17g}, \"J\": {:.17g}, \"cauchy_stress\": {}, \"cauchy_stress_33\": {:.17g}, "
+               "\"first_piola\": {}, \"first_piola_33\": {:.17g}, \"body_force\": {}}}\n",
+               r.name, to_string(setup.geometry), json_vector(X), r.time, json_vector(f.position),
+               json_vector(f.displacement), json_vector(f.velocity), json_vector(f.acceleration),
+               json_matrix(f.deformation_gradient), f.hoop_stretch, f.J, json_matrix(f.cauchy_stress),
+               f.cauchy_stress_33, json_matrix(f.first_piola), f.first_piola_33, json_vector(f.body_force));
+    return 0;
+  }
+  const char* third = rz ? "theta" : "zz";
+  fmt::print(out, "{} ({}) at X = ({}, {}), t = {}\n", r.name, to_string(setup.geometry), X.x(), X.y(), r.time);
+  fmt::print(out, "  position       x     = ({:.10g}, {:.10g})\n", f.position.x(), f.position.y());
+  fmt::print(out, "  displacement   u     = ({:.10g}, {:.10g})\n", f.displacement.x(), f.displacement.y());
+  fmt::print(out, "  velocity       v     = ({:.10g}, {:.10g})\n", f.velocity.x(), f.velocity.y());
+  fmt::print(out, "  acceleration   a     = ({:.10g}, {:.10g})\n", f.acceleration.x(), f.acceleration.y());
+  fmt::print(out, "  F              = [[{:.10g}, {:.10g}], [{:.10g}, {:.10g}]], F_{} = {:.10g}, J = {:.10g}\n",
+             f.deformation_gradient(0, 0), f.deformation_gradient(0, 1), f.deformation_gradient(1, 0),
+             f.deformation_gradient(1, 1), third, f.hoop_stretch, f.J);
+  fmt::print(out, "  Cauchy stress  = [[{:.10g}, {:.10g}], [{:.10g}, {:.10g}]], sigma_{} = {:.10g} Pa\n",
+             f.cauchy_stress(0, 0), f.cauchy_stress(0, 1), f.cauchy_stress(1, 0), f.cauchy_stress(1, 1), third,
+             f.cauchy_stress_33);
+  fmt::print(out, "  body force     b     = ({:.10g}, {:.10g}) m/s^2 (per unit mass)\n", f.body_force.x(),
+             f.body_force.y());
+  return 0;
+}
+
+int mms_check(const MmsCheckRequest& r, std::ostream& out, std::ostream& err) {
+  ProblemSetup setup;
+  Config config("", {});
+  try {
+    const MmsProblem& problem = problem_named(r.name);
+    config = Config(problem.name, problem.keys());
+    for (const std::string& o : r.overrides) config.set_from_text(o);
+    setup = problem.setup(config);
+  } catch (const ConfigError& e) {
+    fmt::print(err, "mpmvv mms check: {}\n", e.what());
+    return 2;
+  }
+  // Random points of the body (rejection sampling in its walled box) and
+  // times in [0, end_time].
+  std::mt19937 rng(r.seed);
+  const Vec2 lo = setup.grid.wall_lower(), hi = setup.grid.wall_upper();
+  std::uniform_real_distribution<double> ux(lo.x(), hi.x()), uy(lo.y(), hi.y()), ut(0.0, config.real("end_time"));
+  // Finite differences reach 2e-3 of the motion's length scale from the point:
+  // stay that far inside the body and off the axis.
+  std::vector<mms::ResidualCheck> checks;
+  std::vector<Vec2> where;
+  int attempts = 0;
+  while (int(checks.size()) < r.points && attempts < 1000 * r.points) {
+    ++attempts;
+    const Vec2 X(ux(rng), uy(rng));
+    const double margin = 0.01 * setup.grid.h;
+    bool inside = setup.contains(X);
+    for (const Vec2& d : {Vec2(margin, 0), Vec2(-margin, 0), Vec2(0, margin), Vec2(0, -margin)})
+      inside = inside && setup.contains(X + d);
+    if (!inside || (setup.geometry == Geometry::axisymmetric && X.x() < 0.02 * hi.x())) continue;
+    checks.push_back(setup.solution->check(X, ut(rng)));
+    where.push_back(X);
+  }
+  double scale = 0.0, worst_global = 0.0, mean_global = 0.0, worst_local = 0.0;
+  for (const auto& c : checks) scale = std::max(scale, c.scale);
+  for (const auto& c : checks) {
+    const double g = c.residual.norm() / scale;
+    worst_global = std::max(worst_global, g);
+    mean_global += g / double(checks.size());
+    if (c.scale > 1e-3 * scale) worst_local = std::max(worst_local, c.relative());
+  }
+  const bool pass = worst_global <= r.tolerance;
+  fmt::print(out, "{}: residual a - Div P / rho_0 - b at {} random points (finite differences against the derived force)\n",
+             r.name, checks.size());
+  fmt::print(out, "  relative to the largest |a| + |Div P / rho_0| + |b| = {:.4g}: max {:.3e}, mean {:.3e}\n", scale,
+             worst_global, mean_global);
+  fmt::print(out, "  pointwise, where the local scale exceeds 1e-3 of it: max {:.3e}\n", worst_local);
+  fmt::print(out, "  {} (tolerance {:.1e})\n", pass ? "PASS" : "FAIL", r.tolerance);
+  return pass ? 0 : 1;
+}
+
+}  // namespace mpmvv::app

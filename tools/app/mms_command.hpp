@@ -1,0 +1,38 @@
+// `mpmvv mms`: the manufactured solutions for a person or a script.
+//   list                 the solutions and their parameters
+//   eval NAME --at X,Y --time T [--set k=v] [--json]
+//                        exact fields and body force at one reference point
+//   check NAME [--points N] [--tolerance E] [--set k=v]
+//                        the residual a - Div P / rho_0 - b by finite differences
+#pragma once
+
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+namespace mpmvv::app {
+
+std::string mms_list();
+
+struct MmsEvalRequest {
+  std::string name;
+  std::vector<double> at;  // X, Y (R, Z in r-z)
+  double time = 0.0;
+  std::vector<std::string> overrides;
+  bool json = false;
+};
+// Exit status 0, or 2 on bad input (one line on err).
+int mms_eval(const MmsEvalRequest& request, std::ostream& out, std::ostream& err);
+
+struct MmsCheckRequest {
+  std::string name;
+  int points = 1000;
+  double tolerance = 1e-8;
+  unsigned seed = 1;
+  std::vector<std::string> overrides;
+};
+// Exit status 0 when the largest residual, relative to the largest force term
+// over the sampled points, is within the tolerance; 1 above; 2 bad input.
+int mms_check(const MmsCheckRequest& request, std::ostream& out, std::ostream& err);
+
+}  // namespace mpmvv::app

@@ -1,0 +1,379 @@
+#include "mms_scene.hpp"
+
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#ifdef MPMVV_HAVE_FFTW
+#include "spectrum.hpp"
+#endif
+
+namespace mpmvv::app {
+
+const char* to_string(ProbeQuantity q) {
+  switch (q) {
+    case ProbeQuantity::angular_displacement: return "angular_displacement";
+    case ProbeQuantity::radial_displacement: return "radial_displacement";
+    case ProbeQuantity::displacement_x: return "displacement_x";
+    case ProbeQuantity::displacement_y: return "displacement_y";
+  }
+  return "?";
+}
+
+std::vector<KeySpec> material_keys(const std::string& default_material, double lambda, double mu, double density) {
+  const double inf = std::numeric_limits<double>::infinity();
+  return {
+      {"material", KeyKind::text, default_material,
+       "neo-hookean (eq. 2.2), mooney-rivlin (eq. 2.18 with K ln J) or linear-elastic (small strain)", -inf, inf,
+       false, false, {"neo-hookean", "mooney-rivlin", "linear-elastic"}},
+      {"lambda", KeyKind::real, lambda, "first Lame constant, neo-hookean and linear-elastic [Pa]"},
+      {"mu", KeyKind::real, mu, "shear modulus, neo-hookean and linear-elastic [Pa]", 0.0, inf, true},
+      {"c1", KeyKind::real, 0.5 * mu, "C1 of mooney-rivlin [Pa] (shear modulus 2 (C1 + C2))"},
+      {"c2", KeyKind::real, 0.0, "C2 of mooney-rivlin [Pa]"},
+      {"bulk_modulus", KeyKind::real, lambda + 2.0 / 3.0 * mu, "K of mooney-rivlin [Pa]", 0.0, inf, true},
+      {"density", KeyKind::real, density, "reference density rho_0 [kg/m^3]", 0.0, inf, true},
+  };
+}
+
+MaterialModel material_from(const Config& c) {
+  const std::string& m = c.text("material");
+  if (m == "mooney-rivlin") {
+    if (!(c.real("c1") + c.real("c2") > 0.0))
+      c.reject("c1", fmt::format("c1 + c2 must be positive (a positive shear modulus); c2 = {} from {}",
+                                 c.real("c2"), c.origin("c2").source));
+    return MooneyRivlin{c.real("c1"), c.real("c2"), c.real("bulk_modulus")};
+  }
+  if (!(c.real("lambda") > -2.0 / 3.0 * c.real("mu")))
+    c.reject("lambda", fmt::format("must exceed -2 mu / 3 = {:.6g} (a positive bulk modulus; mu from {})",
+                                   -2.0 / 3.0 * c.real("mu"), c.origin("mu").source));
+  if (m == "linear-elastic") return LinearElastic{c.real("lambda"), c.real("mu")};
+  return NeoHookean{c.real("lambda"), c.real("mu")};
+}
+
+std::vector<Vec2> points_on_segment(const Vec2& a, const Vec2& b, int count) {
+  std::vector<Vec2> out;
+  for (int i = 0; i < count; ++i) out.push_back(a + (b - a) * (double(i) / double(count - 1)));
+  return out;
+}
+
+namespace {
+
+using std::numbers::pi;
+
+// The quantity at a material point with current position x, reference X and
+// exact current position x_exact. Angles are unwrapped about the exact value
+// (the error stays far below pi).
+double probe_value(ProbeQuantity q, Geometry geometry, const Vec2& x, const Vec2& X, const Vec2& x_exact) {
+  switch (q) {
+    case ProbeQuantity::angular_displacement: {
+      const double reference = std::atan2(X.y(), X.x());
+      const double exact = std::atan2(x_exact.y(), x_exact.x()) - reference;
+      return exact + std::remainder(std::atan2(x.y(), x.x()) - reference - exact, 2.0 * pi);
+    }
+    case ProbeQuantity::radial_displacement:
+      return geometry == Geometry::axisymmetric ? x.x() - X.x() : x.norm() - X.norm();
+    case ProbeQuantity::displacement_x: return x.x() - X.x();
+    case ProbeQuantity::displacement_y: return x.y() - X.y();
+  }
+  return 0.0;
+}
+
+struct LineRecord {
+  std::vector<std::vector<double>> simulated, exact;  // per output time
+};
+
+class MmsCase final : public SceneCase, private RunObserver {
+ public:
+  MmsCase(const Config& config, const MmsProblem& problem)
+      : config_(config), setup_(problem.setup(config)), options_(solver_options(config)),
+        loop_(time_loop_options(config)) {
+    options_.geometry = setup_.geometry;
+    // A probe must be a material point of the body.
+    for (const ProbeLine& line : setup_.lines)
+      for (const Vec2& X : line.reference)
+        if (!setup_.contains(X))
+          throw ConfigError(fmt::format("probe line '{}' has the point ({}, {}) outside the body", line.name,
+                                        X.x(), X.y()));
+    for (const ProbePoint& point : setup_.points)
+      if (!setup_.contains(point.reference))
+        throw ConfigError(fmt::format("probe point '{}' at ({}, {}) lies outside the body", point.name,
+                                      point.reference.x(), point.reference.y()));
+  }
+
+  RunOutcome run(const ProgressSink& progress) override {
+    Model model;
+    model.grid = setup_.grid;
+    seed_particles(model.particles);
+    if (model.particles.size() == 0)
+      throw ConfigError(fmt::format("the body holds no particle centre at cells = {}: use more cells",
+                                    config_.integer("cells")));
+    seed_tracers(model.tracers);
+    std::shared_ptr<BodyForce> force = setup_.fast_body_force;
+    if (!force) force = std::make_shared<mms::DerivedBodyForce>(setup_.solution);
+    stepper_ = make_stepper(std::move(model), options_, setup_.material, std::move(force));
+    outcome_ = run_time_loop(*stepper_, loop_, *this, progress);
+    return outcome_;
+  }
+
+  double cell_size() const override { return setup_.grid.h; }
+  std::size_t particle_count() const override { return stepper_ ? stepper_->model().particles.size() : 0; }
+  const ErrorTable& errors() const override { return errors_; }
+
+  std::string error_description() const override {
+    return "L1_<line>: eq. 3.1 of 000_1dbcb8acb6dddab9.txt, the mean over the line's material points of "
+           "|q_sim - q_exact| for the line's quantity (its 'quantity' attribute; rad or m); particle_L1, "
+           "particle_L2, particle_Linf: norms of the displacement error |x_p - x_exact(X_p, t)| over all "
+           "particles, weighted by reference volume (m)";
+  }
+
+  void write_results(h5::Group& root) const override {
+    write_particles(root, stepper_->model().particles);
+    h5::Group probes = root.create_group("probes");
+    const std::size_t outputs = output_times_.size();
+    for (std::size_t k = 0; k < setup_.lines.size(); ++k) {
+      const ProbeLine& line = setup_.lines[k];
+      h5::Group g = probes.create_group(line.name);
+      const char* q = to_string(line.quantity);
+      g.set_attribute("quantity", q);
+      if (line.reference_angle) g.set_attribute("reference_angle", *line.reference_angle);
+      g.set_attribute("description", fmt::format("material points along {}; {} at each output time", line.parameter_name, q));
+      const std::size_t n = line.reference.size();
+      g.write(line.parameter_name, line.parameter, {n});
+      g.write("reference_position", flatten_points(line.reference), {n, 2});
+      g.write("time", output_times_, {outputs});
+      g.write(q, flatten(line_records_[k].simulated), {outputs, n});
+      g.write(std::string("exact_") + q, flatten(line_records_[k].exact), {outputs, n});
+    }
+    for (std::size_t k = 0; k < setup_.points.size(); ++k) {
+      const ProbePoint& point = setup_.points[k];
+      h5::Group g = probes.create_group(point.name);
+      const char* q = to_string(point.quantity);
+      g.set_attribute("quantity", q);
+      g.set_attribute("reference_position", std::vector<double>{point.reference.x(), point.reference.y()});
+      if (setup_.geometry == Geometry::plane_strain) {
+        g.set_attribute("reference_radius", point.reference.norm());
+        g.set_attribute("reference_angle", std::atan2(point.reference.y(), point.reference.x()));
+      }
+      g.set_attribute("description", fmt::format("history of {} at the material point after every step", q));
+      g.write("time", point_time_, {point_time_.size()});
+      g.write(q, point_simulated_[k], {point_time_.size()});
+      g.write(std::string("exact_") + q, point_exact_[k], {point_time_.size()});
+    }
+    if (setup_.circle) {
+      h5::Group g = probes.create_group("circle");
+      const char* q = to_string(setup_.circle->quantity);
+      g.set_attribute("quantity", q);
+      g.set_attribute("reference_radius", setup_.circle->radius);
+      g.set_attribute("description", fmt::format("material circle: {} around it at each output time", q));
+      g.write("reference_angle", circle_angle_, {circle_angle_.size()});
+      g.write("time", output_times_, {outputs});
+      g.write(q, flatten(circle_simulated_), {outputs, circle_angle_.size()});
+      g.write(std::string("exact_") + q, flatten(circle_exact_), {outputs, circle_angle_.size()});
+#ifdef MPMVV_HAVE_FFTW
+      if (outputs > 0) g.write("error_spectrum", flatten(circle_spectrum_), {outputs, circle_spectrum_.front().size()});
+#endif
+    }
+  }
+
+ private:
+  template <class Rows>
+  static std::vector<double> flatten(const Rows& rows) {
+    std::vector<double> out;
+    for (const auto& r : rows) out.insert(out.end(), r.begin(), r.end());
+    return out;
+  }
+  static std::vector<double> flatten_points(const std::vector<Vec2>& points) {
+    std::vector<double> out;
+    for (const Vec2& p : points) {
+      out.push_back(p.x());
+      out.push_back(p.y());
+    }
+    return out;
+  }
+
+  // Particles on a regular sub-lattice of every cell, kept where their centre
+  // lies in the body; in cell order, so neighbours in memory are neighbours in
+  // space. Each starts in the exact state at t = 0, from the same definition
+  // as the force. In r-z a particle's volume is per radian: R_p times its area.
+  void seed_particles(Particles& P) const {
+    const GridGeometry& grid = setup_.grid;
+    const int ppd = int(config_.integer("particles_per_direction"));
+    const double spacing = grid.h / ppd;
+    std::vector<Vec2> X;
+    for (int j = 0; j < grid.cells_y; ++j)
+      for (int i = 0; i < grid.cells_x; ++i)
+        for (int b = 0; b < ppd; ++b)
+          for (int a = 0; a < ppd; ++a) {
+            const Vec2 x = grid.node_position(i, j) + spacing * Vec2(a + 0.5, b + 0.5);
+            if (setup_.contains(x)) X.push_back(x);
+          }
+    P.resize(X.size());
+    const bool axisymmetric = setup_.geometry == Geometry::axisymmetric;
+    if (axisymmetric) {
+      P.hoop_stretch.resize(X.size());
+      P.hoop_stress.resize(X.size());
+    }
+    const double area = spacing * spacing;
+    const double density = setup_.solution->density();
+    for (std::size_t p = 0; p < X.size(); ++p) {
+      const mms::ExactFields f = setup_.solution->fields(X[p], 0.0);
+      const double reference_volume = axisymmetric ? X[p].x() * area : area;
+      P.reference_position[p] = X[p];
+      P.position[p] = f.position;
+      P.velocity[p] = f.velocity;
+      P.deformation_gradient[p] = f.deformation_gradient;
+      P.stress[p] = f.cauchy_stress;
+      P.reference_volume[p] = reference_volume;
+      P.volume[p] = f.J * reference_volume;
+      P.mass[p] = density * reference_volume;
+      if (axisymmetric) {
+        P.hoop_stretch[p] = f.hoop_stretch;
+        P.hoop_stress[p] = f.cauchy_stress_33;
+      }
+    }
+    if (options_.method != Method::linear) P.half_size.assign(X.size(), Vec2(0.5 * spacing, 0.5 * spacing));
+  }
+
+  void seed_tracers(std::vector<Vec2>& tracers) {
+    const mms::ExactSolution& s = *setup_.solution;
+    line_first_.clear();
+    for (const ProbeLine& line : setup_.lines) {
+      line_first_.push_back(tracers.size());
+      for (const Vec2& X : line.reference) tracers.push_back(s.position(X, 0.0));
+    }
+    line_records_.assign(setup_.lines.size(), {});
+    point_first_ = tracers.size();
+    for (const ProbePoint& point : setup_.points) tracers.push_back(s.position(point.reference, 0.0));
+    point_simulated_.assign(setup_.points.size(), {});
+    point_exact_.assign(setup_.points.size(), {});
+    circle_first_ = tracers.size();
+    circle_angle_.clear();
+    circle_reference_.clear();
+    if (setup_.circle) {
+      for (int j = 0; j < setup_.circle->points; ++j) {
+        const double Theta = 2.0 * pi * j / setup_.circle->points;
+        const Vec2 X = setup_.circle->radius * Vec2(std::cos(Theta), std::sin(Theta));
+        circle_angle_.push_back(Theta);
+        circle_reference_.push_back(X);
+        tracers.push_back(s.position(X, 0.0));
+      }
+    }
+    errors_ = ErrorTable{};
+    for (const ProbeLine& line : setup_.lines) errors_.add_column("L1_" + line.name);
+    for (const char* name : {"particle_L1", "particle_L2", "particle_Linf"}) errors_.add_column(name);
+  }
+
+  double value_at(ProbeQuantity q, const Vec2& x, const Vec2& X, double t) const {
+    return probe_value(q, setup_.geometry, x, X, setup_.solution->position(X, t));
+  }
+  double exact_at(ProbeQuantity q, const Vec2& X, double t) const {
+    const Vec2 x = setup_.solution->position(X, t);
+    return probe_value(q, setup_.geometry, x, X, x);
+  }
+
+  void after_step(double t, const Stepper& s) override {
+    point_time_.push_back(t);
+    for (std::size_t k = 0; k < setup_.points.size(); ++k) {
+      const ProbePoint& point = setup_.points[k];
+      point_simulated_[k].push_back(value_at(point.quantity, s.model().tracers[point_first_ + k], point.reference, t));
+      point_exact_[k].push_back(exact_at(point.quantity, point.reference, t));
+    }
+  }
+
+  void at_output(std::size_t, double t, const Stepper& s) override {
+    const std::vector<Vec2>& tracers = s.model().tracers;
+    output_times_.push_back(t);
+    errors_.time.push_back(t);
+    for (std::size_t k = 0; k < setup_.lines.size(); ++k) {
+      const ProbeLine& line = setup_.lines[k];
+      std::vector<double> sim, ex;
+      double l1 = 0.0;
+      for (std::size_t i = 0; i < line.reference.size(); ++i) {
+        const double value = value_at(line.quantity, tracers[line_first_[k] + i], line.reference[i], t);
+        const double exact = exact_at(line.quantity, line.reference[i], t);
+        sim.push_back(value);
+        ex.push_back(exact);
+        l1 += std::abs(value - exact);
+      }
+      errors_.columns[k].second.push_back(l1 / double(line.reference.size()));  // eq. 3.1
+      line_records_[k].simulated.push_back(std::move(sim));
+      line_records_[k].exact.push_back(std::move(ex));
+    }
+    if (setup_.circle) {
+      std::vector<double> sim, ex, err;
+      for (std::size_t j = 0; j < circle_reference_.size(); ++j) {
+        const double value = value_at(setup_.circle->quantity, tracers[circle_first_ + j], circle_reference_[j], t);
+        const double exact = exact_at(setup_.circle->quantity, circle_reference_[j], t);
+        sim.push_back(value);
+        ex.push_back(exact);
+        err.push_back(value - exact);
+      }
+      circle_simulated_.push_back(std::move(sim));
+      circle_exact_.push_back(std::move(ex));
+#ifdef MPMVV_HAVE_FFTW
+      circle_spectrum_.push_back(amplitude_spectrum(err));
+#endif
+    }
+    // Volume-weighted displacement error over all particles.
+    const Particles& P = s.model().particles;
+    double weight = 0.0, l1 = 0.0, l2 = 0.0, linf = 0.0;
+    for (std::size_t p = 0; p < P.size(); ++p) {
+      const double e = (P.position[p] - setup_.solution->position(P.reference_position[p], t)).norm();
+      const double w = P.reference_volume[p];
+      weight += w;
+      l1 += w * e;
+      l2 += w * e * e;
+      linf = std::max(linf, e);
+    }
+    const std::size_t first = setup_.lines.size();
+    errors_.columns[first].second.push_back(l1 / weight);
+    errors_.columns[first + 1].second.push_back(std::sqrt(l2 / weight));
+    errors_.columns[first + 2].second.push_back(linf);
+  }
+
+  Config config_;
+  ProblemSetup setup_;
+  SolverOptions options_;
+  TimeLoopOptions loop_;
+  std::unique_ptr<Stepper> stepper_;
+  RunOutcome outcome_;
+
+  std::vector<std::size_t> line_first_;
+  std::vector<LineRecord> line_records_;
+  std::size_t point_first_ = 0;
+  std::vector<double> point_time_;
+  std::vector<std::vector<double>> point_simulated_, point_exact_;
+  std::size_t circle_first_ = 0;
+  std::vector<double> circle_angle_;
+  std::vector<Vec2> circle_reference_;
+  std::vector<std::vector<double>> circle_simulated_, circle_exact_, circle_spectrum_;
+  std::vector<double> output_times_;
+  ErrorTable errors_;
+};
+
+}  // namespace
+
+MmsProblem ring_problem();
+MmsProblem axis_aligned_problem();
+MmsProblem expanding_ring_problem();
+MmsProblem rz_cylinder_problem();
+
+const std::vector<MmsProblem>& mms_problems() {
+  static const std::vector<MmsProblem> problems = {ring_problem(), axis_aligned_problem(), expanding_ring_problem(),
+                                                   rz_cylinder_problem()};
+  return problems;
+}
+
+const MmsProblem* find_mms_problem(const std::string& name) {
+  for (const MmsProblem& p : mms_problems())
+    if (p.name == name) return &p;
+  return nullptr;
+}
+
+std::unique_ptr<SceneCase> build_mms_case(const Config& config, const MmsProblem& problem) {
+  return std::make_unique<MmsCase>(config, problem);
+}
+
+}  // namespace mpmvv::app

@@ -1,0 +1,87 @@
+// Scenes of manufactured solutions: a body in its reference configuration, the
+// exact solution that moves it, the body force derived from it, and the probes
+// where the error is measured. Each problem (tools/app/problems/) says what is
+// particular to it; seeding, initial state, probes and norms are shared here.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "mms/exact_solution.hpp"
+#include "scene.hpp"
+
+namespace mpmvv::app {
+
+// What a probe reads off a material point, from its current and reference
+// positions (in r-z, x is r and y is z).
+enum class ProbeQuantity {
+  angular_displacement,  // atan2(x) - atan2(X) [rad]
+  radial_displacement,   // |x| - |X| in plane strain, r - R in r-z [m]
+  displacement_x,        // x - X [m] (r - R in r-z)
+  displacement_y,        // y - Y [m] (z - Z in r-z)
+};
+const char* to_string(ProbeQuantity q);
+
+struct ProbeLine {
+  std::string name;                 // group under /probes
+  ProbeQuantity quantity;
+  std::string parameter_name;       // what the line is parametrised by, e.g. "reference_radius"
+  std::vector<double> parameter;    // its value at each point
+  std::vector<Vec2> reference;      // the material points
+  std::optional<double> reference_angle;  // lines Theta = const of the plane-strain rings
+};
+
+struct ProbePoint {
+  std::string name;                 // recorded after every step
+  ProbeQuantity quantity;
+  Vec2 reference;
+};
+
+// Material points equally spaced around a circle about the origin; the
+// amplitude spectrum of the error around it (FFTW) measures lost axisymmetry.
+struct ProbeCircle {
+  ProbeQuantity quantity;
+  double radius;
+  int points;
+};
+
+// Everything particular to one manufactured problem.
+struct ProblemSetup {
+  std::shared_ptr<const mms::ExactSolution> solution;
+  MaterialModel material;
+  Geometry geometry = Geometry::plane_strain;
+  GridGeometry grid;
+  std::function<bool(const Vec2&)> contains;  // the body, in reference coordinates
+  std::vector<ProbeLine> lines;
+  std::vector<ProbePoint> points;
+  std::optional<ProbeCircle> circle;
+  // A closed form that equals the derived force (tests/test_manufactured.cpp
+  // shows it), used instead of automatic differentiation for speed; absent
+  // otherwise.
+  std::shared_ptr<BodyForce> fast_body_force;
+};
+
+struct MmsProblem {
+  std::string name;
+  std::string summary;
+  std::vector<KeySpec> (*keys)();
+  // Checks the keys that depend on each other (throws ConfigError) and builds.
+  ProblemSetup (*setup)(const Config&);
+};
+
+const std::vector<MmsProblem>& mms_problems();
+const MmsProblem* find_mms_problem(const std::string& name);
+
+std::unique_ptr<SceneCase> build_mms_case(const Config& config, const MmsProblem& problem);
+
+// Material keys every manufactured problem accepts, with its defaults.
+std::vector<KeySpec> material_keys(const std::string& default_material, double lambda, double mu, double density);
+MaterialModel material_from(const Config& config);
+
+// A line of `count` equally spaced points from a to b.
+std::vector<Vec2> points_on_segment(const Vec2& a, const Vec2& b, int count);
+
+}  // namespace mpmvv::app

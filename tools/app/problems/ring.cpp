@@ -1,0 +1,97 @@
+// The ring MMS (PROBLEMS.md section 1; 000_1dbcb8acb6dddab9.txt chapters 2-3)
+// on the Sandia study's square domain with roller walls. Probes: the lines
+// Theta = 0, +45, -45 degrees and the point (R_m, 0) read the angular
+// displacement; the circle R_m gives the angular spectrum of the error.
+#include <cmath>
+#include <numbers>
+
+#include <fmt/format.h>
+
+#include "mms/ring.hpp"
+#include "tools/app/mms_scene.hpp"
+
+namespace mpmvv::app {
+
+namespace {
+
+using std::numbers::pi;
+
+std::vector<KeySpec> keys() {
+  const double inf = std::numeric_limits<double>::infinity();
+  std::vector<KeySpec> k = solver_keys(64, 1.0, {0.1, 0.2, 0.25, 0.3, 0.4, 0.5, 0.6, 0.7, 0.75, 0.8, 0.9, 1.0});
+  const std::vector<KeySpec> ring = {
+      {"amplitude", KeyKind::real, 0.5, "A, the largest angular displacement [rad]", 0.0, 4.0, true},
+      {"time_function", KeyKind::text, std::string("cosine"),
+       "g(t): cosine = (A/2)(1 - cos 2 pi t) (Sandia report), sine = A sin(pi t) (MMS paper)", -inf, inf, false,
+       false, {"cosine", "sine"}},
+      {"inner_radius", KeyKind::real, 0.75, "inner radius R_i of the ring [m]", 0.0, inf, true},
+      {"outer_radius", KeyKind::real, 1.25, "outer radius R_o of the ring [m]", 0.0, inf, true},
+      {"domain", KeyKind::real, 3.0, "width of the square domain centred on the ring [m]", 0.0, inf, true},
+      {"probe_points", KeyKind::integer, std::int64_t(51), "material points on each probe line", 2, 100000},
+      {"circle_points", KeyKind::integer, std::int64_t(128),
+       "material points on the circle R = (R_i + R_o)/2 for the angular spectrum", 8, 65536},
+  };
+  k.insert(k.end(), ring.begin(), ring.end());
+  const std::vector<KeySpec> material = material_keys("neo-hookean", 577.0, 385.0, 1000.0);
+  k.insert(k.end(), material.begin(), material.end());
+  return k;
+}
+
+ProblemSetup setup(const Config& c) {
+  mms::RingParameters p;
+  p.inner_radius = c.real("inner_radius");
+  p.outer_radius = c.real("outer_radius");
+  p.amplitude = c.real("amplitude");
+  p.time_function = c.text("time_function") == "sine" ? mms::RingTimeFunction::sine : mms::RingTimeFunction::cosine;
+  p.lambda = c.real("lambda");
+  p.mu = c.real("mu");
+  p.density = c.real("density");
+
+  ProblemSetup s;
+  s.material = material_from(c);
+  s.geometry = Geometry::plane_strain;
+  const double domain = c.real("domain");
+  const int cells = int(c.integer("cells"));
+  s.grid = GridGeometry::walled(Vec2(-0.5 * domain, -0.5 * domain), domain / cells, cells, cells);
+  if (!(p.outer_radius > p.inner_radius))
+    c.reject("outer_radius", fmt::format("must exceed inner_radius = {} (from {})", p.inner_radius,
+                                         c.origin("inner_radius").source));
+  // The motion keeps every radius, so the ring never comes nearer the walls.
+  if (p.outer_radius + 2.0 * s.grid.h > 0.5 * domain)
+    c.reject("domain", fmt::format("the ring (outer radius {}) needs two cells of clearance inside the "
+                                   "{} m domain (h = {:.4g} m)", p.outer_radius, domain, s.grid.h));
+  if (p.outer_radius - p.inner_radius < s.grid.h)
+    c.reject("cells", fmt::format("the ring is {} m wide but a cell is {:.4g} m: use more cells",
+                                  p.outer_radius - p.inner_radius, s.grid.h));
+
+  s.solution = mms::make_solution(mms::RingMotion{p}, s.material, p.density, s.geometry);
+  s.contains = [p](const Vec2& X) {
+    const double R = X.norm();
+    return R >= p.inner_radius && R <= p.outer_radius;
+  };
+  const int n = int(c.integer("probe_points"));
+  const double angles[3] = {0.0, pi / 4.0, -pi / 4.0};
+  const char* names[3] = {"theta0", "theta_plus45", "theta_minus45"};
+  for (int k = 0; k < 3; ++k) {
+    const Vec2 direction(std::cos(angles[k]), std::sin(angles[k]));
+    ProbeLine line{names[k], ProbeQuantity::angular_displacement, "reference_radius", {}, {}, angles[k]};
+    line.reference = points_on_segment(p.inner_radius * direction, p.outer_radius * direction, n);
+    for (const Vec2& X : line.reference) line.parameter.push_back(X.norm());
+    s.lines.push_back(std::move(line));
+  }
+  const double middle = 0.5 * (p.inner_radius + p.outer_radius);
+  s.points.push_back({"point_R1", ProbeQuantity::angular_displacement, Vec2(middle, 0.0)});
+  s.circle = ProbeCircle{ProbeQuantity::angular_displacement, middle, int(c.integer("circle_points"))};
+  // Eqs. 2.14-2.15 belong to the neo-Hookean solid; other materials use the derived force.
+  if (std::holds_alternative<NeoHookean>(s.material))
+    s.fast_body_force = std::make_shared<mms::RingClosedFormBodyForce>(mms::RingMms(p));
+  return s;
+}
+
+}  // namespace
+
+MmsProblem ring_problem() {
+  return {"ring", "ring MMS: circles of a ring turned by alpha = g(t) h(R) (PROBLEMS.md section 1)", keys, setup};
+}
+
+}  // namespace mpmvv::app
