@@ -12,6 +12,9 @@ def write_ring_results(path, cells, l1_at_times, times, method="cpdi", amplitude
     with h5py.File(path, "w") as f:
         f.attrs["h"] = h
         f.attrs["cells"] = np.int64(cells)
+        f.attrs["scene"] = "ring"
+        f.attrs["particles_per_direction"] = np.int64(2)
+        f.attrs["forcing_time_s"] = 0.1
         f.attrs["method"] = method
         f.attrs["amplitude"] = amplitude
         f.attrs["status"] = status

@@ -1,10 +1,13 @@
 #!/usr/bin/python3
-"""Status and error of ring results files, grouped by amplitude and method:
-whether each run completed (or when and why it stopped), its wall time, the
-L1 error of eq. 3.1 (000_1dbcb8acb6dddab9.txt) on Theta = 0 at chosen times,
-and the observed order between consecutive meshes of the same group.
+"""Status and error of results files, grouped by scene, amplitude, variant and
+method: whether each run completed (or when and why it stopped), its wall
+time, chosen error norms at chosen times, and the observed order between
+consecutive meshes of the same group.
 
-Usage: /usr/bin/python3 reports/study_table.py [--times 0.25,1.0] RESULTS.h5 ...
+Usage: /usr/bin/python3 reports/study_table.py [--times 0.25,1.0]
+           [--norms L1_theta0,particle_L2] RESULTS.h5 ...
+Without --times: the last output time. Without --norms: the first probe line's
+L1 (eq. 3.1 of 000_1dbcb8acb6dddab9.txt) and the particle L2 norm.
 """
 import argparse
 import math
@@ -13,59 +16,83 @@ from collections import defaultdict
 
 import h5py
 
+METHOD_ORDER = {"linear": 0, "gimp": 1, "cpdi": 2}
 
-def read_case(path, times):
+
+def text(value):
+    return value.decode() if isinstance(value, bytes) else str(value)
+
+
+def read_case(path, times, norms):
     with h5py.File(path, "r") as f:
-        recorded = list(f["errors/time"][:])
-        l1 = list(f["errors/L1_theta0"][:])
+        errors = f["errors"]
+        recorded = list(errors["time"][:])
+        columns = [name for name in errors.keys() if name != "time"]
+        chosen = norms or [columns[0], "particle_L2"]
+        wanted = times or ([max(recorded)] if recorded else [])
         values = {}
-        for t in times:
-            hits = [k for k, r in enumerate(recorded) if abs(r - t) < 1e-9]
-            values[t] = l1[hits[0]] if hits else float("nan")
+        for norm in chosen:
+            series = list(errors[norm][:]) if norm in errors else []
+            for t in wanted:
+                hits = [k for k, r in enumerate(recorded) if abs(r - t) < 1e-12 * max(1.0, abs(t))]
+                values[(norm, t)] = series[hits[0]] if hits and hits[0] < len(series) else float("nan")
+        attrs = f.attrs
         return {
-            "amplitude": float(f.attrs["amplitude"]),
-            "method": str(f.attrs["method"]),
-            "cells": int(f.attrs["cells"]),
-            "h": float(f.attrs["h"]),
-            "status": str(f.attrs["status"]),
-            "reason": str(f.attrs["failure_reason"]),
-            "failure_time": float(f.attrs["failure_time"]),
-            "wall": float(f.attrs["wall_time_s"]),
-            "steps": int(f.attrs["steps"]),
-            "rate": float(f.attrs["particle_steps_per_second"]),
-            "l1": values,
+            "scene": text(attrs["scene"]) if "scene" in attrs else "ring",
+            "amplitude": float(attrs["amplitude"]) if "amplitude" in attrs else float("nan"),
+            "variant": text(attrs["variant"]) if "variant" in attrs else "",
+            "extra": f"R_i={float(attrs['inner_radius']):g}" if text(attrs.get("scene", "")) == "rz-cylinder" else "",
+            "method": text(attrs["method"]),
+            "cells": int(attrs["cells"]),
+            "ppd": int(attrs["particles_per_direction"]),
+            "h": float(attrs["h"]),
+            "status": text(attrs["status"]),
+            "reason": text(attrs["failure_reason"]),
+            "failure_time": float(attrs["failure_time"]),
+            "wall": float(attrs["wall_time_s"]),
+            "forcing": float(attrs["forcing_time_s"]) if "forcing_time_s" in attrs else float("nan"),
+            "steps": int(attrs["steps"]),
+            "columns": [(norm, t) for norm in chosen for t in wanted],
+            "values": values,
         }
 
 
-def order(coarse, fine):
-    a, b = coarse["l1"], fine["l1"]
-    return {t: (math.log(a[t] / b[t]) / math.log(coarse["h"] / fine["h"])
-                if a[t] > 0 and b[t] > 0 else float("nan")) for t in a}
+def order(coarse, fine, key):
+    a, b = coarse["values"].get(key, float("nan")), fine["values"].get(key, float("nan"))
+    if a > 0 and b > 0 and coarse["h"] != fine["h"]:
+        return math.log(a / b) / math.log(coarse["h"] / fine["h"])
+    return float("nan")
 
 
 def main(argv):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--times", default="0.25,1.0", help="output times to tabulate")
+    parser.add_argument("--times", default="", help="output times to tabulate (default: the last)")
+    parser.add_argument("--norms", default="", help="error columns (default: first probe line L1, particle_L2)")
     parser.add_argument("files", nargs="+")
     args = parser.parse_args(argv)
-    times = [float(t) for t in args.times.split(",")]
+    times = [float(t) for t in args.times.split(",")] if args.times else []
+    norms = args.norms.split(",") if args.norms else []
     groups = defaultdict(list)
     for path in args.files:
-        c = read_case(path, times)
-        groups[(c["amplitude"], c["method"])].append(c)
-    for key in sorted(groups, key=lambda k: (k[0], ["linear", "gimp", "cpdi"].index(k[1]) if k[1] in ("linear", "gimp", "cpdi") else 9)):
+        c = read_case(path, times, norms)
+        groups[(c["scene"], c["variant"], c["extra"], c["amplitude"], c["ppd"], c["method"])].append(c)
+    for key in sorted(groups, key=lambda k: (k[0], k[1], k[2], k[3], k[4], METHOD_ORDER.get(k[5], 9))):
         cases = sorted(groups[key], key=lambda c: c["cells"])
-        print(f"\nA = {key[0]:g}, {key[1]}")
-        head = f"{'cells':>6} {'outcome':<34} {'wall [s]':>9} {'steps':>6}"
-        head += "".join(f" {'L1 t=' + format(t, 'g'):>11} {'order':>6}" for t in times)
+        scene, variant, extra, amplitude, ppd, method = key
+        label = ", ".join(x for x in (scene, variant, extra, f"A = {amplitude:g}", f"{ppd} per direction", method) if x)
+        print(f"\n{label}")
+        columns = cases[0]["columns"]
+        head = f"{'cells':>6} {'outcome':<34} {'wall [s]':>9} {'forcing':>8} {'steps':>6}"
+        head += "".join(f" {n + ' t=' + format(t, 'g'):>22} {'order':>6}" for n, t in columns)
         print(head)
         previous = None
         for c in cases:
             outcome = "completed" if c["status"] == "completed" else f"failed t={c['failure_time']:.3f} ({c['reason']})"
-            row = f"{c['cells']:>6} {outcome:<34} {c['wall']:>9.3g} {c['steps']:>6}"
-            p = order(previous, c) if previous else {}
-            for t in times:
-                row += f" {c['l1'][t]:>11.3e} {p.get(t, float('nan')):>6.2f}"
+            forcing = c["forcing"] / c["wall"] if c["wall"] > 0 else float("nan")
+            row = f"{c['cells']:>6} {outcome:<34} {c['wall']:>9.3g} {forcing:>7.0%} {c['steps']:>6}"
+            for col in columns:
+                p = order(previous, c, col) if previous else float("nan")
+                row += f" {c['values'].get(col, float('nan')):>22.3e} {p:>6.2f}"
             print(row)
             previous = c
     return 0

@@ -24,7 +24,7 @@ def test_convergence_table_prints_order_two(second_order_series, capsys):
 def test_study_table_orders_and_failures(second_order_series, tmp_path, capsys):
     failed = tmp_path / "ring-256.h5"
     write_ring_results(failed, 256, [0.1], [0.25], status="failed", failure_reason="nan", failure_time=0.31)
-    assert study_table.main(second_order_series + [str(failed)]) == 0
+    assert study_table.main(["--times", "0.25,1.0", "--norms", "L1_theta0"] + second_order_series + [str(failed)]) == 0
     out = capsys.readouterr().out
     assert "failed t=0.310 (nan)" in out
     rows = [line for line in out.splitlines() if line.strip().startswith(("64", "128"))]

@@ -264,8 +264,11 @@ void update_stress(const Material& material, Particles& P) {
 // ---------------------------------------------------------------- tracers
 
 // Massless probe points move with the grid velocity, interpolated with the
-// bilinear hat: they sample the motion the method computes without changing
-// it. A tracer that leaves the grid becomes NaN.
+// bilinear hat and weighted by nodal mass, v = sum S m v / sum S m: they sample
+// the motion the method computes without changing it, and at a free surface
+// the nodes beyond the body, which carry only a sliver of mass and whatever
+// velocity that sliver gives them, do not drag a tracer on the surface along.
+// A tracer that leaves the grid, or finds no mass around it, becomes NaN.
 inline void advect_tracers(const GridGeometry& grid, const GridFields& g, std::vector<Vec2>& tracers,
                            double dt) {
   for (Vec2& x : tracers) {
@@ -275,11 +278,18 @@ inline void advect_tracers(const GridGeometry& grid, const GridFields& g, std::v
     }
     int node[4];
     double w[4];
-    Vec2 grad[4];
-    bilinear_cell(grid, x, node, w, grad);
-    Vec2 v = Vec2::Zero();
-    for (int k = 0; k < 4; ++k) v += w[k] * g.velocity[node[k]];
-    x += dt * v;
+    bilinear_cell_weights(grid, x, node, w);
+    Vec2 momentum = Vec2::Zero();
+    double mass = 0.0;
+    for (int k = 0; k < 4; ++k) {
+      momentum += w[k] * g.mass[node[k]] * g.velocity[node[k]];
+      mass += w[k] * g.mass[node[k]];
+    }
+    if (mass > 0.0) {
+      x += dt * momentum / mass;
+    } else {
+      x.setConstant(std::numeric_limits<double>::quiet_NaN());
+    }
   }
 }
 

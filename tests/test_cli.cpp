@@ -137,4 +137,93 @@ TEST_F(Cli, DescribeListsResolvedKeys) {
   EXPECT_NE(o.out.find("output_times = "), std::string::npos) << o.out;
 }
 
+// ---------------------------------------------------------------- mpmvv mms
+
+// `mms list` exits 0 and names the four manufactured solutions.
+TEST_F(Cli, MmsListNamesTheSolutions) {
+  const Outcome o = mpmvv("mms list");
+  EXPECT_EQ(o.status, 0) << o.err;
+  for (const char* name : {"ring:", "axis-aligned:", "expanding-ring:", "rz-cylinder:"})
+    EXPECT_NE(o.out.find(name), std::string::npos) << name << "\n" << o.out;
+  EXPECT_EQ(o.err, "");
+}
+
+// `mms eval --json` exits 0 and prints one JSON object (one line, braces
+// around it) with the body force, displacement, velocity, F and Cauchy stress;
+// at the ring's mid-radius the reference point is the one asked for.
+TEST_F(Cli, MmsEvalPrintsOneJsonObject) {
+  const Outcome o = mpmvv("mms eval ring --at 1,0 --time 0.25 --json");
+  EXPECT_EQ(o.status, 0) << o.err;
+  const std::vector<std::string> lines = lines_of(o.out);
+  ASSERT_EQ(lines.size(), 1u) << o.out;
+  const std::string& json = lines[0];
+  EXPECT_EQ(json.front(), '{') << json;
+  EXPECT_EQ(json.back(), '}') << json;
+  for (const char* key : {"\"body_force\":", "\"displacement\":", "\"velocity\":", "\"F\":", "\"cauchy_stress\":",
+                          "\"reference_position\": [1, 0]", "\"time\": 0.25"})
+    EXPECT_NE(json.find(key), std::string::npos) << key << "\n" << json;
+  EXPECT_EQ(o.err, "");
+}
+
+// A point outside the body (the ring is 0.75 <= R <= 1.25): exit 2, one line
+// on stderr saying so, nothing on stdout.
+TEST_F(Cli, MmsEvalOutsideTheBodyExitsTwo) {
+  const Outcome o = mpmvv("mms eval ring --at 2,0 --time 0");
+  EXPECT_EQ(o.status, 2);
+  const std::vector<std::string> lines = lines_of(o.err);
+  ASSERT_EQ(lines.size(), 1u) << o.err;
+  EXPECT_NE(lines[0].find("outside the body"), std::string::npos) << lines[0];
+  EXPECT_EQ(o.out, "");
+}
+
+// An unknown solution: exit 2, one line naming it and the known ones.
+TEST_F(Cli, MmsEvalUnknownSolutionExitsTwo) {
+  const Outcome o = mpmvv("mms eval nope --at 1,0 --time 0");
+  EXPECT_EQ(o.status, 2);
+  const std::vector<std::string> lines = lines_of(o.err);
+  ASSERT_EQ(lines.size(), 1u) << o.err;
+  EXPECT_NE(lines[0].find("'nope'"), std::string::npos) << lines[0];
+  EXPECT_NE(lines[0].find("rz-cylinder"), std::string::npos) << lines[0];
+}
+
+// `mms check` passes on the axis-aligned solution at the default tolerance
+// 1e-8 (measured max relative residual 2.5e-10 at 200 points): exit 0, PASS.
+TEST_F(Cli, MmsCheckPasses) {
+  const Outcome o = mpmvv("mms check axis-aligned --points 200");
+  EXPECT_EQ(o.status, 0) << o.out << o.err;
+  EXPECT_NE(o.out.find("PASS"), std::string::npos) << o.out;
+  EXPECT_EQ(o.out.find("FAIL"), std::string::npos) << o.out;
+}
+
+// The finite differences of the check cannot reach 1e-14 (their round-off is
+// about 1e-10): exit 1, FAIL. The check can fail.
+TEST_F(Cli, MmsCheckFailsBelowTheRoundOffOfTheDifferences) {
+  const Outcome o = mpmvv("mms check axis-aligned --points 50 --tolerance 1e-14");
+  EXPECT_EQ(o.status, 1) << o.out << o.err;
+  EXPECT_NE(o.out.find("FAIL"), std::string::npos) << o.out;
+}
+
+// An unknown solution to check is bad input: exit 2.
+TEST_F(Cli, MmsCheckUnknownSolutionExitsTwo) {
+  const Outcome o = mpmvv("mms check nope --points 10");
+  EXPECT_EQ(o.status, 2);
+  EXPECT_EQ(lines_of(o.err).size(), 1u) << o.err;
+}
+
+// An r-z solution reports its geometry and F33 = r / R (0.52793508 / 0.5 at
+// R = 0.5, Z = 0.25, t = 0.25 for the default cylinder); on the axis of the
+// solid cylinder it refuses to evaluate (exit 2, one line).
+TEST_F(Cli, MmsEvalRzReportsHoopStretchAndRefusesTheAxis) {
+  const Outcome o = mpmvv("mms eval rz-cylinder --at 0.5,0.25 --time 0.25 --json");
+  EXPECT_EQ(o.status, 0) << o.err;
+  EXPECT_NE(o.out.find("\"geometry\": \"axisymmetric\""), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("\"F33\": 1.05587016"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("\"position\": [0.52793508"), std::string::npos) << o.out;
+  const Outcome axis = mpmvv("mms eval rz-cylinder --at 0,0.5 --time 0.25 --set inner_radius=0");
+  EXPECT_EQ(axis.status, 2);
+  const std::vector<std::string> lines = lines_of(axis.err);
+  ASSERT_EQ(lines.size(), 1u) << axis.err;
+  EXPECT_NE(lines[0].find("R > 0"), std::string::npos) << lines[0];
+}
+
 }  // namespace

@@ -3,7 +3,7 @@
 // modulus the time step relies on (000_1dbcb8acb6dddab9.txt eqs. 2.2, 2.18).
 #include <gtest/gtest.h>
 
-#include "deformations.hpp"
+#include "support.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -28,11 +28,11 @@ class RingConvergence : public ::testing::TestWithParam<const char*> {};
 
 // L1 on Theta = 0 at t = 0.25 s, A = 0.5, cosine time function, 2 particles per
 // cell per direction, cfl 0.3, cells 32 -> 64 -> 128 (h halves each time).
-// Measured (all three methods, this build): pairwise orders 1.49-1.53 then
-// 2.21-2.25, overall 1.85-1.89; the pairwise order alternates like this up to
-// 512 cells (1.5, 2.2, 1.5, 2.2 for GIMP and CPDI) because the particle lattice
-// meets the rims differently at each h. Band: overall order in [1.6, 2.1],
-// each pairwise order in [1.2, 2.6].
+// Measured (all three methods, mass-weighted tracers): pairwise orders
+// 1.51-1.56 then 2.28-2.36, overall 1.90-1.96; the pairwise order alternates
+// like this up to 512 cells (1.5, 2.2, 1.5, 2.2 for GIMP and CPDI) because the
+// particle lattice meets the rims differently at each h. Band: overall order
+// in [1.6, 2.1], each pairwise order in [1.2, 2.6].
 TEST_P(RingConvergence, L1FallsAtObservedOrderInBand) {
   const std::string method = GetParam();
   std::vector<double> l1;

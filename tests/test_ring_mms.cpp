@@ -4,6 +4,8 @@
 // and the exact fields are consistent with each other.
 #include <gtest/gtest.h>
 
+#include "support.hpp"
+
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -16,6 +18,8 @@
 #include "mms/ring.hpp"
 
 namespace {
+
+using mpmvv::testing::scientific;
 
 using mpmvv::Mat2;
 using mpmvv::Vec2;
@@ -85,12 +89,6 @@ RingMms with_mu_scaled(const RingMms& ring, double factor) {
   RingParameters p = ring.parameters();
   p.mu *= factor;
   return RingMms(p);
-}
-
-std::string scientific(double x) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.3e", x);
-  return text;
 }
 
 template <class Solution>

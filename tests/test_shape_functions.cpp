@@ -5,7 +5,7 @@
 // +-(h + l), and the last positions `inside` still accepts next to a wall.
 #include <gtest/gtest.h>
 
-#include "deformations.hpp"
+#include "support.hpp"
 
 #include <cmath>
 #include <cstddef>

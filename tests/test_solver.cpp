@@ -4,6 +4,8 @@
 // that lands on its output times within the CFL step.
 #include <gtest/gtest.h>
 
+#include "support.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -20,6 +22,8 @@
 #include "solver/time_loop.hpp"
 
 namespace {
+
+using mpmvv::testing::scientific;
 
 using mpmvv::Mat2;
 using mpmvv::MaterialModel;
@@ -38,12 +42,6 @@ constexpr double kDensity = 1000.0;  // rho_0 [kg/m^3]
 
 const Method kMethods[] = {Method::linear, Method::gimp, Method::cpdi};
 const Scheme kSchemes[] = {Scheme::usl, Scheme::usf, Scheme::musl};
-
-std::string scientific(double x) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.3e", x);
-  return text;
-}
 
 std::string label(Method m, Scheme s) { return std::string(to_string(m)) + "/" + to_string(s); }
 

@@ -118,6 +118,8 @@ class MmsCase final : public SceneCase, private RunObserver {
   }
 
   double cell_size() const override { return setup_.grid.h; }
+  Geometry geometry() const override { return setup_.geometry; }
+  std::string body_force_kind() const override { return setup_.fast_body_force ? "closed form" : "derived"; }
   std::size_t particle_count() const override { return stepper_ ? stepper_->model().particles.size() : 0; }
   const ErrorTable& errors() const override { return errors_; }
 

@@ -92,6 +92,8 @@ void write_results_file(const std::string& path, const RunRequest& request, cons
   root.set_attribute("forcing_time_s", o.forcing_seconds);
   root.set_attribute("particle_steps_per_second", o.wall_seconds > 0 ? double(o.particle_steps) / o.wall_seconds : 0.0);
   root.set_attribute("h", scene.cell_size());
+  root.set_attribute("geometry", to_string(scene.geometry()));
+  root.set_attribute("body_force", scene.body_force_kind());
   root.set_attribute("dt", o.dt_first);
   root.set_attribute("dt_min", o.dt_min);
   root.set_attribute("dt_max", o.dt_max);

@@ -35,6 +35,9 @@ class SceneCase {
   // Cell size, for the results file.
   virtual double cell_size() const = 0;
   virtual std::size_t particle_count() const = 0;
+  virtual Geometry geometry() const = 0;
+  // How the body force is evaluated ("derived", "closed form"), or "none".
+  virtual std::string body_force_kind() const = 0;
   // Writes particles and probes under `root` (the errors are written from errors()).
   virtual void write_results(h5::Group& root) const = 0;
   virtual const ErrorTable& errors() const = 0;

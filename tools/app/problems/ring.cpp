@@ -30,6 +30,10 @@ std::vector<KeySpec> keys() {
       {"probe_points", KeyKind::integer, std::int64_t(51), "material points on each probe line", 2, 100000},
       {"circle_points", KeyKind::integer, std::int64_t(128),
        "material points on the circle R = (R_i + R_o)/2 for the angular spectrum", 8, 65536},
+      {"body_force", KeyKind::text, std::string("closed-form"),
+       "closed-form: eqs. 2.14-2.15 (neo-hookean only; equal to the derived force to round-off); derived: "
+       "automatic differentiation of the motion and material",
+       -inf, inf, false, false, {"closed-form", "derived"}},
   };
   k.insert(k.end(), ring.begin(), ring.end());
   const std::vector<KeySpec> material = material_keys("neo-hookean", 577.0, 385.0, 1000.0);
@@ -83,8 +87,13 @@ ProblemSetup setup(const Config& c) {
   s.points.push_back({"point_R1", ProbeQuantity::angular_displacement, Vec2(middle, 0.0)});
   s.circle = ProbeCircle{ProbeQuantity::angular_displacement, middle, int(c.integer("circle_points"))};
   // Eqs. 2.14-2.15 belong to the neo-Hookean solid; other materials use the derived force.
-  if (std::holds_alternative<NeoHookean>(s.material))
+  if (c.text("body_force") == "closed-form") {
+    if (!std::holds_alternative<NeoHookean>(s.material))
+      c.reject("body_force", fmt::format("the closed form (eqs. 2.14-2.15) holds for the neo-Hookean solid only; "
+                                         "material = \"{}\" (from {}) needs body_force = \"derived\"",
+                                         c.text("material"), c.origin("material").source));
     s.fast_body_force = std::make_shared<mms::RingClosedFormBodyForce>(mms::RingMms(p));
+  }
   return s;
 }
 

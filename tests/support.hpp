@@ -1,12 +1,21 @@
-// Deformation gradients the tests share.
+// What the tests share: deformation gradients and number formatting.
 #pragma once
 
 #include <cmath>
+#include <cstdio>
 #include <random>
+#include <string>
 
 #include "solver/tensor.hpp"
 
 namespace mpmvv::testing {
+
+// x in scientific notation with `digits` after the point, for test properties.
+inline std::string scientific(double x, int digits = 3) {
+  char text[40];
+  std::snprintf(text, sizeof text, "%.*e", digits, x);
+  return text;
+}
 
 inline Mat2 rotation(double angle) {
   Mat2 q;
