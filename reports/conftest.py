@@ -22,6 +22,7 @@ def write_ring_results(path, cells, l1_at_times, times, method="cpdi", amplitude
         f.attrs["failure_time"] = failure_time
         f.attrs["time_reached"] = times[-1] if status == "completed" else failure_time
         f.attrs["wall_time_s"] = 1.0
+        f.attrs["end_time"] = times[-1]
         f.attrs["steps"] = np.int64(10)
         f.attrs["particle_steps_per_second"] = 1e6
         e = f.create_group("errors")

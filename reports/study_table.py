@@ -6,7 +6,7 @@ consecutive meshes of the same group.
 
 Usage: /usr/bin/python3 reports/study_table.py [--times 0.25,1.0]
            [--norms L1_theta0,particle_L2] RESULTS.h5 ...
-Without --times: the last output time. Without --norms: the first probe line's
+Without --times: the scene's end time. Without --norms: the first probe line's
 L1 (eq. 3.1 of 000_1dbcb8acb6dddab9.txt) and the particle L2 norm.
 """
 import argparse
@@ -29,7 +29,7 @@ def read_case(path, times, norms):
         recorded = list(errors["time"][:])
         columns = [name for name in errors.keys() if name != "time"]
         chosen = norms or [columns[0], "particle_L2"]
-        wanted = times or ([max(recorded)] if recorded else [])
+        wanted = times or [float(f.attrs["end_time"])]
         values = {}
         for norm in chosen:
             series = list(errors[norm][:]) if norm in errors else []

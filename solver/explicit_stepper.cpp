@@ -77,8 +77,11 @@ class ExplicitStepper final : public Stepper {
         return {"nan", fmt::format("non-finite hoop stress at x = ({:.6g}, {:.6g})", x.x(), x.y())};
     const double J = determinant(P.deformation_gradient[p]) * out_of_plane_stretch<Shape::geometry>(P, p);
     if (!(J > 0.0)) return {"non-positive J", fmt::format("J = {:.6g} at x = ({:.6g}, {:.6g})", J, x.x(), x.y())};
-    if (!shape.inside(p))
+    if (!shape.inside(p)) {
+      if (!inside_walls(model_.grid, x))
+        return {"outside grid", fmt::format("the particle at ({:.6g}, {:.6g}) has crossed a wall", x.x(), x.y())};
       return {"outside grid", fmt::format("support of the particle at ({:.6g}, {:.6g}) leaves the grid", x.x(), x.y())};
+    }
     return {"", ""};
   }
 

@@ -80,9 +80,19 @@ Handle::~Handle() {
   if (id_ >= 0 && closer_) closer_(id_);
 }
 
+// Groups remember the order their members were written in, so that readers
+// list probe lines and error columns as the scene made them.
+Handle ordered_group_properties(const std::string& what) {
+  Handle gcpl(check(H5Pcreate(H5P_GROUP_CREATE), "H5Pcreate", what), H5Pclose);
+  check_status(H5Pset_link_creation_order(gcpl.get(), H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED),
+               "H5Pset_link_creation_order", what);
+  return gcpl;
+}
+
 Group Group::create_group(const std::string& name) {
   const std::string p = join(path_, name);
-  return Group(Handle(check(H5Gcreate2(id(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), "H5Gcreate2", p),
+  Handle gcpl = ordered_group_properties(p);
+  return Group(Handle(check(H5Gcreate2(id(), name.c_str(), H5P_DEFAULT, gcpl.get(), H5P_DEFAULT), "H5Gcreate2", p),
                       H5Gclose),
                p);
 }
@@ -188,7 +198,10 @@ std::vector<double> Group::read_doubles(const std::string& name, std::vector<hsi
 }
 
 File File::create(const std::string& path) {
-  return File(Handle(check(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), "H5Fcreate", path),
+  Handle fcpl(check(H5Pcreate(H5P_FILE_CREATE), "H5Pcreate", path), H5Pclose);
+  check_status(H5Pset_link_creation_order(fcpl.get(), H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED),
+               "H5Pset_link_creation_order", path);
+  return File(Handle(check(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, fcpl.get(), H5P_DEFAULT), "H5Fcreate", path),
                      H5Fclose),
               path);
 }

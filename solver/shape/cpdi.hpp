@@ -91,11 +91,12 @@ struct CpdiShapeT {
     }
   }
 
-  // Every corner of the domain lies in the grid (in r-z: r >= 0, off the axis
-  // at the centre).
+  // The centre lies between the walls (in r-z off the axis) and every corner
+  // of the domain in the grid (ghost layers included).
   bool inside(std::size_t p) const {
     if constexpr (G == Geometry::axisymmetric)
       if (!(position[p].x() > 0.0)) return false;
+    if (!inside_walls(*grid, position[p])) return false;
     const Mat2 s = domain(p);
     for (int c = 0; c < 4; ++c)
       if (!inside_cells(*grid, grid_coordinate(*grid, corner(p, s, c)))) return false;

@@ -124,11 +124,13 @@ struct GimpShapeT {
     }
   }
 
-  // The particle's domain lies inside the grid.
+  // The particle's centre lies between the walls and its domain inside the
+  // grid (ghost layers included).
   bool inside(std::size_t p) const {
     const Vec2 lo = position[p] - half_size[p], hi = position[p] + half_size[p];
     const Vec2 top = grid->upper();
-    return lo.x() >= grid->origin.x() && lo.y() >= grid->origin.y() && hi.x() <= top.x() && hi.y() <= top.y();
+    return inside_walls(*grid, position[p]) && lo.x() >= grid->origin.x() && lo.y() >= grid->origin.y() &&
+           hi.x() <= top.x() && hi.y() <= top.y();
   }
 };
 

@@ -75,11 +75,11 @@ struct LinearShapeT {
     }
   }
 
-  // The particle's cell lies inside the grid (and, in r-z, off the axis).
+  // The particle lies between the walls (and, in r-z, off the axis).
   bool inside(std::size_t p) const {
     if constexpr (G == Geometry::axisymmetric)
       if (!(position[p].x() > 0.0)) return false;
-    return inside_cells(*grid, grid_coordinate(*grid, position[p]));
+    return inside_walls(*grid, position[p]);
   }
 };
 

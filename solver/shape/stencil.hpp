@@ -38,6 +38,13 @@ inline bool inside_cells(const GridGeometry& grid, const Vec2& xi) {
   return xi.x() >= 0.0 && xi.x() <= grid.cells_x && xi.y() >= 0.0 && xi.y() <= grid.cells_y;
 }
 
+// True when the point lies between the walls (closed). A particle's centre
+// must; its support may reach into the ghost layers beyond.
+inline bool inside_walls(const GridGeometry& grid, const Vec2& x) {
+  const Vec2 lo = grid.wall_lower(), hi = grid.wall_upper();
+  return x.x() >= lo.x() && x.x() <= hi.x() && x.y() >= lo.y() && x.y() <= hi.y();
+}
+
 // Index of the cell holding grid coordinate xi >= 0 along an axis of n cells;
 // the upper wall belongs to the last cell.
 inline int cell_index(double xi, int n) { return std::min(static_cast<int>(xi), n - 1); }
