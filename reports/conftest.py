@@ -1,6 +1,9 @@
 """Shared pytest fixtures: synthetic ring results files with the layout of
-reports/results-format.md, so the report scripts are tested on data whose
-answer is known."""
+reports/results-format.md and synthetic suite output directories with the
+layout of suites/README.md, so the report, the gate and the tables are tested
+on data whose answer is known."""
+import json
+
 import h5py
 import numpy as np
 import pytest
@@ -42,3 +45,128 @@ def second_order_series(tmp_path):
         write_ring_results(path, cells, [0.7 * h * h, 0.7 * h * h], times)
         paths.append(str(path))
     return paths
+
+
+RING_TIMES = [0.25, 0.5, 1.0]
+PROBE_POINTS = 11
+CIRCLE_POINTS = 16
+
+
+def write_case_results(path, keys, h, errors_at_times, times, status="completed", failure_reason="",
+                       failure_time=float("nan"), wall_time_s=1.0):
+    """A results file with the layout of reports/results-format.md: root attributes
+    (every key, h, status, ...), /errors with `errors_at_times` (column -> values at
+    `times`), and ring-like probes whose arrays reproduce the L1_theta0 column:
+    simulated = exact + that error at every point, so eq. 3.1 gives it back."""
+    end_time = float(keys.get("end_time", RING_TIMES[-1]))
+    radius = np.linspace(0.75, 1.25, PROBE_POINTS)
+    angle = np.linspace(0.0, 2.0 * np.pi, CIRCLE_POINTS, endpoint=False)
+    line_error = np.asarray(errors_at_times.get("L1_theta0", [0.0] * len(times)), float)
+    with h5py.File(path, "w") as f:
+        for name, value in keys.items():
+            f.attrs[name] = np.asarray(value, dtype=float) if isinstance(value, list) else value
+        f.attrs.update({"h": h, "status": status, "failure_reason": failure_reason, "failure_time": failure_time,
+                        "time_reached": end_time if status == "completed" else failure_time,
+                        "wall_time_s": wall_time_s, "end_time": end_time, "steps": np.int64(100),
+                        "particle_count": np.int64(1000), "scene": "ring"})
+        e = f.create_group("errors")
+        e["time"] = np.asarray(times, float)
+        for name, values in errors_at_times.items():
+            e[name] = np.asarray(values, float)
+        probes = f.create_group("probes")
+        line = probes.create_group("theta0")
+        line.attrs["quantity"] = "angular_displacement"
+        line["reference_radius"] = radius
+        line["reference_position"] = np.stack([radius, 0.0 * radius], axis=1)
+        line["time"] = np.asarray(times, float)
+        exact = np.array([np.sin(np.pi * (radius - 0.75) / 0.5) * t for t in times]).reshape(len(times), -1)
+        line["exact_angular_displacement"] = exact
+        line["angular_displacement"] = exact + line_error[:, None]
+        point = probes.create_group("point_R1")
+        point.attrs["quantity"] = "angular_displacement"
+        point.attrs["reference_position"] = np.array([1.0, 0.0])
+        steps = np.linspace(0.0, times[-1] if times else 0.0, 21)
+        point["time"] = steps
+        point["exact_angular_displacement"] = 0.5 * np.sin(np.pi * steps)
+        point["angular_displacement"] = 0.5 * np.sin(np.pi * steps) + h * h * steps
+        circle = probes.create_group("circle")
+        circle.attrs["quantity"] = "angular_displacement"
+        circle.attrs["reference_radius"] = 1.0
+        circle["reference_angle"] = angle
+        circle["time"] = np.asarray(times, float)
+        circle["exact_angular_displacement"] = np.zeros((len(times), CIRCLE_POINTS))
+        circle["angular_displacement"] = np.array([h * np.cos(4 * angle) for _ in times]).reshape(len(times), -1)
+        circle["error_spectrum"] = np.array([[h * (k == 4) + 1e-12 for k in range(CIRCLE_POINTS // 2 + 1)]
+                                             for _ in times]).reshape(len(times), -1)
+
+
+def write_suite_directory(directory, suite_toml, cases):
+    """DIR/suite.toml, DIR/manifest.json and DIR/cases/<id>.{h5,json} (suites/README.md).
+    cases: dicts with id, study, keys, status and, for cases that ran, h, errors,
+    times (and optionally failure_reason, failure_time)."""
+    directory.mkdir(parents=True, exist_ok=True)
+    (directory / "cases").mkdir(exist_ok=True)
+    (directory / "suite.toml").write_text(suite_toml)
+    entries = []
+    for case in cases:
+        entry = {"id": case["id"], "study": case["study"], "keys": case["keys"], "results": f"cases/{case['id']}.h5",
+                 "status": case["status"], "exit_code": 0, "wall_time_s": 1.0, "detail": case.get("detail", "")}
+        if "errors" in case:
+            write_case_results(directory / entry["results"], case["keys"], case["h"], case["errors"], case["times"],
+                               status="failed" if case["status"] == "failed" else "completed",
+                               failure_reason=case.get("failure_reason", ""),
+                               failure_time=case.get("failure_time", float("nan")))
+        (directory / "cases" / f"{case['id']}.json").write_text(json.dumps(entry))
+        entries.append(entry)
+    (directory / "manifest.json").write_text(json.dumps({"suite": "synthetic", "suite_file": "suites/synthetic.toml",
+                                                         "cases": entries}))
+    return directory
+
+
+SYNTHETIC_SUITE = """description = "synthetic ring suite: cpdi errors exactly 0.5 h^2, linear errors 0.2 h"
+
+[[study]]
+name = "ring"
+scene = "scenes/ring.toml"
+sweep = { method = ["linear", "cpdi"], cells = [32, 64, 128, 256] }
+
+[[expect]]
+study = "ring"
+where = { method = "cpdi" }
+norm = "L1_theta0"
+levels = [32, 64, 128]
+order = 2.0
+tolerance = 0.1
+max_error_constant = 0.6
+"""
+
+
+def synthetic_ring_cases(linear_fails_at_64=True):
+    """Two series on cells 32..256: cpdi with E = 0.5 h^2 (its 256-cell case still
+    pending), linear with E = 0.2 h whose 64-cell case failed at t = 0.3 (after the
+    first output) and whose 128-cell case crashed; particle norms follow the same law."""
+    cases = []
+    for method, law in (("linear", lambda h: 0.2 * h), ("cpdi", lambda h: 0.5 * h * h)):
+        for cells in (32, 64, 128, 256):
+            keys = {"method": method, "cells": cells, "amplitude": 0.5, "end_time": 1.0,
+                    "particles_per_direction": 2, "output_times": RING_TIMES}
+            case = {"id": f"ring-method={method}-cells={cells}", "study": "ring", "keys": keys,
+                    "status": "completed"}
+            h = 3.0 / cells
+            errors = {name: [law(h) * t for t in RING_TIMES] for name in ("L1_theta0", "particle_L1", "particle_L2")}
+            if method == "linear" and cells == 64 and linear_fails_at_64:
+                case.update(status="failed", failure_reason="non-positive J", failure_time=0.3, times=RING_TIMES[:1],
+                            errors={k: v[:1] for k, v in errors.items()}, h=h)
+            elif method == "linear" and cells == 128:
+                case.update(status="crashed", detail="signal 11 (SIGSEGV)")
+            elif method == "cpdi" and cells == 256:
+                case.update(status="pending")
+            else:
+                case.update(h=h, times=RING_TIMES, errors=errors)
+            cases.append(case)
+    return cases
+
+
+@pytest.fixture
+def synthetic_suite(tmp_path):
+    return write_suite_directory(tmp_path / "suite", SYNTHETIC_SUITE, synthetic_ring_cases())

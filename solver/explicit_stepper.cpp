@@ -40,9 +40,10 @@ template <class Shape, class Material>
 class ExplicitStepper final : public Stepper {
  public:
   ExplicitStepper(Model model, Scheme scheme, Material material,
-                  std::shared_ptr<BodyForce> body_force)
+                  std::shared_ptr<BodyForce> body_force, double gradient_scale)
       : Stepper(std::move(model)),
         scheme_(scheme),
+        gradient_scale_(gradient_scale),
         material_(material),
         body_force_(std::move(body_force)) {
     buffers_.resize(max_threads(), model_.grid.node_count());
@@ -62,12 +63,12 @@ class ExplicitStepper final : public Stepper {
   }
 
   ParticleScan scan() const override {
-    return scan_particles(Shape::bind(model_.grid, model_.particles), material_, model_.particles);
+    return scan_particles(bind(model_.particles), material_, model_.particles);
   }
 
   ParticleFault diagnose(std::size_t p) const override {
     const Particles& P = model_.particles;
-    const Shape shape = Shape::bind(model_.grid, P);
+    const Shape shape = bind(P);
     const Vec2& x = P.position[p];
     if (!(x.allFinite() && P.velocity[p].allFinite() && P.deformation_gradient[p].allFinite() &&
           P.stress[p].allFinite()))
@@ -90,7 +91,7 @@ class ExplicitStepper final : public Stepper {
   // stress at t_n, then velocity, position, F and finally stress.
   void step_usl(double t, double dt, double kick) {
     Particles& P = model_.particles;
-    const Shape shape = Shape::bind(model_.grid, P);
+    const Shape shape = bind(P);
     map_mass_momentum_and_forces(shape, t);
     update_grid_motion(fields_, kick);
     apply_walls(model_.grid, fields_);
@@ -111,7 +112,7 @@ class ExplicitStepper final : public Stepper {
       step_start_deformation_ = P.deformation_gradient;
       domain_deformation = step_start_deformation_.data();
     }
-    const Shape shape = Shape::bind(model_.grid, P, domain_deformation);
+    const Shape shape = bind(P, domain_deformation);
     particles_to_grid<kMass | kMomentum>(shape, P, buffers_, fields_);
     grid_velocity_from_momentum(fields_);
     apply_walls(model_.grid, fields_);
@@ -133,7 +134,7 @@ class ExplicitStepper final : public Stepper {
   // velocities at t_{n+1} mapped back to the grid, with the weights at x_n.
   void step_musl(double t, double dt, double kick) {
     Particles& P = model_.particles;
-    const Shape shape = Shape::bind(model_.grid, P);
+    const Shape shape = bind(P);
     map_mass_momentum_and_forces(shape, t);
     update_grid_motion(fields_, kick);
     apply_walls(model_.grid, fields_);
@@ -145,6 +146,10 @@ class ExplicitStepper final : public Stepper {
     grid_to_particles<kDeformation, Shape>(shape, fields_, P, dt, kick);
     P.position.swap(next_position_);
     update_stress<Shape::geometry>(material_, P);
+  }
+
+  Shape bind(const Particles& P, const Mat2* domain_deformation = nullptr) const {
+    return Shape::bind(model_.grid, P, domain_deformation, gradient_scale_);
   }
 
   void map_mass_momentum_and_forces(const Shape& shape, double t) {
@@ -168,6 +173,7 @@ class ExplicitStepper final : public Stepper {
   }
 
   Scheme scheme_;
+  double gradient_scale_;
   Material material_;
   std::shared_ptr<BodyForce> body_force_;
   ScatterBuffers buffers_;
@@ -181,7 +187,8 @@ std::unique_ptr<Stepper> make_for_shape(Model model, const SolverOptions& o, con
   return std::visit(
       [&](const auto& m) -> std::unique_ptr<Stepper> {
         using Material = std::decay_t<decltype(m)>;
-        return std::make_unique<ExplicitStepper<Shape, Material>>(std::move(model), o.scheme, m, std::move(body_force));
+        return std::make_unique<ExplicitStepper<Shape, Material>>(std::move(model), o.scheme, m, std::move(body_force),
+                                                                 o.cpdi_gradient_scale);
       },
       material);
 }

@@ -30,6 +30,10 @@ struct SolverOptions {
   Method method = Method::cpdi;
   Scheme scheme = Scheme::usl;
   Geometry geometry = Geometry::plane_strain;
+  // A deliberate fault, for showing that a verification gate catches one
+  // (MPMVV_FAULT=cpdi-gradient): the CPDI gradients are scaled by this factor.
+  // 1 in every real run.
+  double cpdi_gradient_scale = 1.0;
 };
 
 // A body force supplied by the scene, per unit mass. One call fills the whole

@@ -108,6 +108,32 @@ bool Group::has(const std::string& name) const {
   return r > 0;
 }
 
+bool Group::has_attribute(const std::string& name) const {
+  const htri_t r = H5Aexists(id(), name.c_str());
+  if (r < 0) fail("H5Aexists", path_ + "@" + name);
+  return r > 0;
+}
+
+std::vector<std::string> Group::members() const {
+  std::vector<std::string> names;
+  H5G_info_t info;
+  check_status(H5Gget_info(id(), &info), "H5Gget_info", path_);
+  // Groups written by mpmvv track creation order; others list by name.
+  Handle gcpl(check(H5Gget_create_plist(id()), "H5Gget_create_plist", path_), H5Pclose);
+  unsigned flags = 0;
+  check_status(H5Pget_link_creation_order(gcpl.get(), &flags), "H5Pget_link_creation_order", path_);
+  const H5_index_t index = (flags & H5P_CRT_ORDER_INDEXED) ? H5_INDEX_CRT_ORDER : H5_INDEX_NAME;
+  for (hsize_t k = 0; k < info.nlinks; ++k) {
+    const ssize_t length = H5Lget_name_by_idx(id(), ".", index, H5_ITER_INC, k, nullptr, 0, H5P_DEFAULT);
+    if (length < 0) fail("H5Lget_name_by_idx", path_);
+    std::string name(std::size_t(length), '\0');
+    if (H5Lget_name_by_idx(id(), ".", index, H5_ITER_INC, k, name.data(), std::size_t(length) + 1, H5P_DEFAULT) < 0)
+      fail("H5Lget_name_by_idx", path_);
+    names.push_back(name);
+  }
+  return names;
+}
+
 void Group::set_attribute(const std::string& name, double value) {
   const std::string what = path_ + "@" + name;
   Handle space = scalar_space(what);

@@ -37,6 +37,9 @@ class Group {
   Group create_group(const std::string& name);
   Group open_group(const std::string& name) const;
   bool has(const std::string& name) const;
+  bool has_attribute(const std::string& name) const;
+  // Names of the group's members, in the order they were written.
+  std::vector<std::string> members() const;
 
   void set_attribute(const std::string& name, double value);
   void set_attribute(const std::string& name, std::int64_t value);

@@ -38,15 +38,16 @@ struct CpdiShapeT {
   const Vec2* position;
   const Mat2* deformation_gradient;
   const Vec2* half_size;
+  double gradient_scale;  // 1, but for a deliberate fault (SolverOptions::cpdi_gradient_scale)
 
   // The domains span F_p diag(l_p); `deformation_gradient` may point to a copy
   // of F taken at the start of a step, so that every transfer of the step uses
   // the same domains.
   static CpdiShapeT bind(const GridGeometry& grid, const Particles& particles,
-                         const Mat2* deformation_gradient = nullptr) {
+                         const Mat2* deformation_gradient = nullptr, double gradient_scale = 1.0) {
     return {&grid, particles.position.data(),
             deformation_gradient ? deformation_gradient : particles.deformation_gradient.data(),
-            particles.half_size.data()};
+            particles.half_size.data(), gradient_scale};
   }
 
   // s_p = [r_1 r_2], the current domain half-vectors as columns (eq. 1.97).
@@ -64,7 +65,7 @@ struct CpdiShapeT {
   void evaluate(std::size_t p, Stencil<stencil_size>& st) const {
     const Mat2 s = domain(p);
     // s^-T = [[s11, -s10], [-s01, s00]] / det s.
-    const double inv_det = 1.0 / determinant(s);
+    const double inv_det = gradient_scale / determinant(s);
     double weight_r = 0.0, weight_a = 0.0, weight_b = 0.0;
     if constexpr (G == Geometry::axisymmetric) {
       weight_r = 1.0 / (3.0 * position[p].x());

@@ -77,7 +77,8 @@ struct GimpShapeT {
   const Vec2* position;
   const Vec2* half_size;
 
-  static GimpShapeT bind(const GridGeometry& grid, const Particles& particles, const Mat2* = nullptr) {
+  static GimpShapeT bind(const GridGeometry& grid, const Particles& particles, const Mat2* = nullptr,
+                       double = 1.0) {
     return {&grid, particles.position.data(), particles.half_size.data()};
   }
 

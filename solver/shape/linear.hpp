@@ -63,7 +63,8 @@ struct LinearShapeT {
   const GridGeometry* grid;
   const Vec2* position;
 
-  static LinearShapeT bind(const GridGeometry& grid, const Particles& particles, const Mat2* = nullptr) {
+  static LinearShapeT bind(const GridGeometry& grid, const Particles& particles, const Mat2* = nullptr,
+                       double = 1.0) {
     return {&grid, particles.position.data()};
   }
 

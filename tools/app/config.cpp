@@ -69,16 +69,24 @@ std::string KeySpec::describe_range() const {
   return what;
 }
 
+// The shortest text that reads back as the same double, with a decimal point
+// so that TOML and JSON readers see a real number (1.0, not 1).
+std::string real_text(double x) {
+  std::string s = fmt::format("{}", x);
+  if (std::isfinite(x) && s.find_first_of(".eE") == std::string::npos) s += ".0";
+  return s;
+}
+
 std::string format_value(const Value& v) {
   return std::visit(
       [](const auto& x) -> std::string {
         using T = std::decay_t<decltype(x)>;
         if constexpr (std::is_same_v<T, std::int64_t>) return std::to_string(x);
-        else if constexpr (std::is_same_v<T, double>) return fmt::format("{}", x);  // shortest round-trip
+        else if constexpr (std::is_same_v<T, double>) return real_text(x);
         else if constexpr (std::is_same_v<T, std::string>) return "\"" + x + "\"";
         else {
           std::string s = "[";
-          for (std::size_t i = 0; i < x.size(); ++i) s += (i ? ", " : "") + fmt::format("{}", x[i]);
+          for (std::size_t i = 0; i < x.size(); ++i) s += (i ? ", " : "") + real_text(x[i]);
           return s + "]";
         }
       },

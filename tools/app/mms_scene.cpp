@@ -1,5 +1,7 @@
 #include "mms_scene.hpp"
 
+#include "fault.hpp"
+
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -102,6 +104,11 @@ class MmsCase final : public SceneCase, private RunObserver {
                                       point.reference.x(), point.reference.y()));
   }
 
+  void inject(Fault fault) override {
+    fault_ = fault;
+    options_.cpdi_gradient_scale = fault == Fault::cpdi_gradient ? kFaultyCpdiGradientScale : 1.0;
+  }
+
   RunOutcome run(const ProgressSink& progress) override {
     Model model;
     model.grid = setup_.grid;
@@ -112,6 +119,7 @@ class MmsCase final : public SceneCase, private RunObserver {
     seed_tracers(model.tracers);
     std::shared_ptr<BodyForce> force = setup_.fast_body_force;
     if (!force) force = std::make_shared<mms::DerivedBodyForce>(setup_.solution);
+    if (fault_ == Fault::no_body_force) force = nullptr;
     stepper_ = make_stepper(std::move(model), options_, setup_.material, std::move(force));
     outcome_ = run_time_loop(*stepper_, loop_, *this, progress);
     return outcome_;
@@ -336,6 +344,7 @@ class MmsCase final : public SceneCase, private RunObserver {
   }
 
   Config config_;
+  Fault fault_ = Fault::none;
   ProblemSetup setup_;
   SolverOptions options_;
   TimeLoopOptions loop_;

@@ -3,17 +3,21 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <sstream>
+#include <thread>
 
 #include <fmt/format.h>
 #include <fmt/ostream.h>
 
 #include "config.hpp"
+#include "fault.hpp"
 #include "scene.hpp"
 #include "solver/parallel.hpp"
 
@@ -23,6 +27,28 @@ namespace fs = std::filesystem;
 
 std::string version_string() {
   return fmt::format("mpmvv {} (commit {}; built with: {})", MPMVV_VERSION, MPMVV_GIT_COMMIT, MPMVV_FEATURES);
+}
+
+int run_report_tool(const std::string& script, const std::vector<std::string>& arguments, std::ostream& err) {
+  const std::string python = "/usr/bin/python3";
+  const std::string path = std::string(MPMVV_REPORTS_DIR) + "/" + script;
+  if (!fs::exists(python)) {
+    fmt::print(err, "mpmvv: {} is missing: run tools/install-deps (Debian's python3 with numpy, h5py, matplotlib)\n", python);
+    return 2;
+  }
+  if (!fs::exists(path)) {
+    fmt::print(err, "mpmvv: the report tools are missing ({} not found)\n", path);
+    return 2;
+  }
+  std::vector<std::string> args = {python, path};
+  args.insert(args.end(), arguments.begin(), arguments.end());
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  err.flush();
+  execv(python.c_str(), argv.data());
+  fmt::print(err, "mpmvv: cannot start {}: {}\n", python, std::strerror(errno));
+  return 2;
 }
 
 namespace {
@@ -57,7 +83,7 @@ void set_key_attribute(h5::Group& root, const std::string& name, const Value& v)
 }
 
 void write_results_file(const std::string& path, const RunRequest& request, const Config& config,
-                        const SceneCase& scene, const RunOutcome& o) {
+                        const SceneCase& scene, const RunOutcome& o, Fault fault) {
   h5::File file = h5::File::create(path);
   h5::Group root = file.root();
   // Every scene key as an attribute of its own, then what the run measured.
@@ -76,6 +102,7 @@ void write_results_file(const std::string& path, const RunRequest& request, cons
   root.set_attribute("overrides", overrides);
   root.set_attribute("command_line", request.command_line);
   root.set_attribute("version", version_string());
+  if (fault != Fault::none) root.set_attribute("fault_injected", to_string(fault));
   root.set_attribute("threads", std::int64_t(max_threads()));
   root.set_attribute("status", o.completed ? "completed" : "failed");
   root.set_attribute("failure_reason", o.failure_reason);
@@ -148,10 +175,13 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
   std::unique_ptr<SceneCase> scene;
   Config config("", {});
   std::string output = request.output;
+  Fault fault = Fault::none;
   try {
     config = load(request.scene_file, request.overrides);
     scene = find_scene_type(config.scene())->build(config);
     if (output.empty()) output = fs::path(request.scene_file).stem().string() + ".h5";
+    fault = injected_fault(output);
+    scene->inject(fault);
     if (fs::path(output).extension() != ".h5")
       throw ConfigError(fmt::format("-o {}: the results file must end in .h5", output));
     const fs::path parent = fs::absolute(output).parent_path();
@@ -163,6 +193,8 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
     return 2;
   }
   set_threads(request.threads);
+  if (fault == Fault::crash) std::abort();
+  while (fault == Fault::hang) std::this_thread::sleep_for(std::chrono::seconds(1));
 
   if (!request.quiet)
     fmt::print(err, "mpmvv run {} -> {} ({} threads)\nconfiguration:{}\n", request.scene_file, output, max_threads(),
@@ -179,7 +211,7 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
   // looks whole.
   const std::string partial = output + ".partial";
   try {
-    write_results_file(partial, request, config, *scene, o);
+    write_results_file(partial, request, config, *scene, o, fault);
     fs::rename(partial, output);
   } catch (const std::exception& e) {
     std::error_code ec;

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "config.hpp"
+#include "fault.hpp"
 #include "solver/io/hdf5.hpp"
 #include "solver/model.hpp"
 #include "solver/time_loop.hpp"
@@ -32,6 +33,8 @@ class SceneCase {
   virtual ~SceneCase() = default;
   // Steps the scene to its end time (or to the step that stopped it).
   virtual RunOutcome run(const ProgressSink& progress) = 0;
+  // A deliberate fault (tools/app/fault.hpp), set before run().
+  virtual void inject(Fault fault) = 0;
   // Cell size, for the results file.
   virtual double cell_size() const = 0;
   virtual std::size_t particle_count() const = 0;

@@ -9,6 +9,7 @@
 
 #include "tools/app/config.hpp"
 #include "tools/app/mms_command.hpp"
+#include "tools/app/suite.hpp"
 #include "tools/app/run_case.hpp"
 
 namespace {
@@ -42,6 +43,28 @@ int main(int argc, char** argv) {
   run_cmd->add_flag("--describe", run.describe, "print every key of the scene with its value and meaning, then stop");
 
   app.add_subcommand("scenes", "List the scenes and the keys each accepts.");
+
+  mpmvv::app::SuiteRequest suite;
+  CLI::App* suite_cmd = app.add_subcommand(
+      "suite", "Run every case of a suite, each in a process of its own; resumable; shares cases over MPI ranks under "
+               "mpirun.\nExit status: 0 every case completed or was stopped by the solver, 1 a case crashed, timed out "
+               "or was refused, 2 bad input, 130 interrupted (rerun to resume).");
+  suite_cmd->add_option("suite", suite.suite_file, "suite file (TOML), e.g. suites/ring-quick.toml")->required();
+  suite_cmd->add_option("-j,--jobs", suite.jobs, "cases at once (per MPI rank)")->check(CLI::Range(1, 1024));
+  suite_cmd->add_option("-o,--output", suite.output_dir, "output directory; default results/<suite name>")->type_name("DIR");
+  suite_cmd->add_flag("-q,--quiet", suite.quiet, "no progress");
+  suite_cmd->add_flag("--list", suite.list, "check the suite and list its cases with their settings; run nothing");
+
+  std::string report_dir, report_out;
+  CLI::App* report_cmd = app.add_subcommand(
+      "report", "Tables, figures, report.html, report.md and orders.csv from a suite's results (no solver runs).");
+  report_cmd->add_option("dir", report_dir, "suite output directory")->required();
+  report_cmd->add_option("-o,--output", report_out, "where to write; default DIR/report")->type_name("DIR");
+  std::string gate_dir;
+  CLI::App* gate_cmd = app.add_subcommand(
+      "gate", "Check every expectation of a suite against its results.\nExit status: 0 all hold, 1 some fell short "
+              "(with a table), 2 bad input.");
+  gate_cmd->add_option("dir", gate_dir, "suite output directory")->required();
 
   CLI::App* mms_cmd = app.add_subcommand("mms", "Manufactured solutions: list them, evaluate one, check its body force.");
   mms_cmd->require_subcommand(1);
@@ -104,6 +127,13 @@ int main(int argc, char** argv) {
     if (eval_cmd->parsed()) return mpmvv::app::mms_eval(eval, std::cout, std::cerr);
     if (check_cmd->parsed()) return mpmvv::app::mms_check(check, std::cout, std::cerr);
   }
+  if (suite_cmd->parsed()) return mpmvv::app::run_suite(suite, std::cout, std::cerr);
+  if (report_cmd->parsed()) {
+    std::vector<std::string> args = {report_dir};
+    if (!report_out.empty()) args.insert(args.end(), {"-o", report_out});
+    return mpmvv::app::run_report_tool("report.py", args, std::cerr);
+  }
+  if (gate_cmd->parsed()) return mpmvv::app::run_report_tool("gate.py", {gate_dir}, std::cerr);
   if (app.got_subcommand("scenes")) {
     std::cout << mpmvv::app::describe_scenes();
     return 0;

@@ -62,9 +62,10 @@ ProblemSetup setup(const Config& c) {
   s.solution = mms::make_solution(motion, s.material, c.real("density"), s.geometry);
 
   const int cells = int(c.integer("cells"));
-  // The strip is two cells high, walls above and below.
+  // The strip is two cells high, walls above and below. The body's extent is
+  // L (not a sum of cells, which rounds) so that probes on its sides belong to it.
   s.grid = GridGeometry::walled(Vec2::Zero(), L / cells, cells, one_d ? 2 : cells);
-  const double height = s.grid.wall_upper().y();
+  const double height = one_d ? 2.0 * L / cells : L;
   s.contains = [L, height](const Vec2& X) { return X.x() >= 0.0 && X.x() <= L && X.y() >= 0.0 && X.y() <= height; };
 
   const int n = int(c.integer("probe_points"));

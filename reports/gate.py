@@ -1,0 +1,236 @@
+#!/usr/bin/python3
+"""Gate a suite output directory on its expectations (suites/README.md, [[expect]]).
+
+For every [[expect]] of DIR/suite.toml: take the cases of its study whose
+resolved keys match every entry of `where`; split them into refinement series
+(reports/series.py); in each series take the levels (values of `refine`,
+default "cells"; all, or those listed in `levels`) sorted by cell size h, read
+the error `norm` at output `time` (default: each case's end time) from /errors,
+and fit the least-squares order of ln E against ln h (reports/orders.py). The
+expectation holds for a series when
+
+* the fitted order lies in [order - tolerance, order + tolerance];
+* max over the levels of E / h^order <= max_error_constant (when given);
+* every level's case completed (when must_complete, the default);
+* at least two levels are usable (have a finite error at that time).
+
+Prints one row per (expectation, series) and a closing line; exit 0 when every
+expectation holds, 1 when one falls short, 2 (one line) when DIR is not a
+readable suite output directory or an [[expect]] is malformed.
+
+Usage: /usr/bin/python3 reports/gate.py DIR
+"""
+import argparse
+import math
+import sys
+from dataclasses import dataclass
+
+from orders import OrderFit, least_squares_order
+from results import SuiteDirectoryError, read_suite
+from series import DEFAULT_REFINE_KEY, Series, matches, refinement_series, series_levels, usable
+
+NUMBER = (int, float)
+EXPECT_KEYS = {
+    "study": (str,), "norm": (str,), "order": NUMBER, "tolerance": NUMBER,
+    "where": (dict,), "time": NUMBER, "refine": (str,), "levels": (list,),
+    "max_error_constant": NUMBER, "must_complete": (bool,),
+}
+REQUIRED_KEYS = ("study", "norm", "order", "tolerance")
+
+
+@dataclass(frozen=True)
+class Verdict:
+    number: int                 # 1-based position of the [[expect]] in suite.toml
+    expectation: dict
+    series: Series              # None when no case matched
+    levels: tuple               # series.Level, coarse first
+    fit: OrderFit
+    error_constant: float       # max over usable levels of E / h^order
+    reasons: tuple              # why it fell short; empty when it holds
+    notes: tuple                # levels left out of a passing fit
+
+    @property
+    def passed(self):
+        return not self.reasons
+
+
+def validate_expectations(suite):
+    """Raise SuiteDirectoryError naming the first malformed [[expect]] key."""
+    where = suite.directory / "suite.toml"
+    studies = set(suite.study_names())
+    for number, expect in enumerate(suite.expectations, start=1):
+        if not isinstance(expect, dict):
+            raise SuiteDirectoryError(f"{where}: [[expect]] {number} is not a table")
+        for key in REQUIRED_KEYS:
+            if key not in expect:
+                raise SuiteDirectoryError(f"{where}: [[expect]] {number}: '{key}' is required")
+        for key, value in expect.items():
+            if key not in EXPECT_KEYS:
+                raise SuiteDirectoryError(f"{where}: [[expect]] {number}: unknown key '{key}' "
+                                          f"(allowed: {', '.join(sorted(EXPECT_KEYS))})")
+            if not isinstance(value, EXPECT_KEYS[key]) or (EXPECT_KEYS[key] is NUMBER and isinstance(value, bool)):
+                raise SuiteDirectoryError(f"{where}: [[expect]] {number}: '{key}' has the wrong type ({value!r})")
+        if expect["study"] not in studies:
+            raise SuiteDirectoryError(f"{where}: [[expect]] {number}: no study named '{expect['study']}'")
+        if expect["tolerance"] < 0:
+            raise SuiteDirectoryError(f"{where}: [[expect]] {number}: 'tolerance' must be >= 0")
+
+
+def check_expectation(number, expect, suite):
+    """One Verdict per refinement series among the cases the expectation selects."""
+    where = expect.get("where", {})
+    refine = expect.get("refine", DEFAULT_REFINE_KEY)
+    cases = [c for c in suite.cases_of(expect["study"]) if matches(c.keys, where)]
+    nan_fit = least_squares_order([], [])
+    if not cases:
+        return [Verdict(number, expect, None, (), nan_fit, float("nan"),
+                        (f"no case of study '{expect['study']}' matches where = {where}",), ())]
+    all_series = refinement_series(cases, refine)
+    if not all_series:
+        return [Verdict(number, expect, None, (), nan_fit, float("nan"),
+                        (f"no matched case has the refine key '{refine}'",), ())]
+    return [check_series(number, expect, s) for s in all_series]
+
+
+def check_series(number, expect, series):
+    levels = series_levels(series, expect["norm"], expect.get("time"), expect.get("levels"))
+    good = usable(levels)
+    fit = least_squares_order([l.h for l in good], [l.error for l in good])
+    order, tolerance = float(expect["order"]), float(expect["tolerance"])
+    constant = max((l.error / l.h ** order for l in good), default=float("nan"))
+    reasons, notes = [], []
+    if expect.get("must_complete", True):
+        unfinished = [l for l in levels if l.case is None or not l.case.completed]
+        if unfinished:
+            reasons.append("not completed: " + "; ".join(_level_outcome(series, l) for l in unfinished))
+    if len(good) < 2:
+        left_out = [f"{series.refine}={l.value}: {l.reason}" for l in levels if l.reason]
+        reasons.append(f"{len(good)} usable level(s), need 2" + (f" ({'; '.join(left_out)})" if left_out else ""))
+    elif not math.isfinite(fit.order):
+        zero = [l for l in good if not l.error > 0]
+        if zero:
+            reasons.append("the error is exactly zero at " + ", ".join(f"{series.refine}={l.value}" for l in zero)
+                           + ": no order can be fitted (does the run measure this norm?)")
+        else:
+            reasons.append("cell size h does not vary over the usable levels: no order")
+    elif not order - tolerance <= fit.order <= order + tolerance:
+        reasons.append(f"order {fit.order:.3f} outside [{order - tolerance:g}, {order + tolerance:g}]")
+    limit = expect.get("max_error_constant")
+    if limit is not None and math.isfinite(constant) and constant > limit:
+        reasons.append(f"E/h^{order:g} = {constant:.3g} > {limit:g}")
+    if len(good) >= 2:
+        notes = [f"left out {series.refine}={l.value} ({l.reason})" for l in levels if l.reason]
+    return Verdict(number, expect, series, tuple(levels), fit, constant, tuple(reasons), tuple(notes))
+
+
+def _level_outcome(series, level):
+    if level.case is None:
+        return level.reason
+    case = level.case
+    outcome = case.status
+    if case.status == "failed" and math.isfinite(case.time_reached):
+        outcome += f" at t = {case.time_reached:.3g}"
+    if case.failure_reason:
+        outcome += f" ({case.failure_reason})"
+    return f"{series.refine}={level.value} {outcome}"
+
+
+def series_description(where, series):
+    """The keys that select the series: the expectation's `where` and the keys that vary between its series."""
+    keys = dict(where)
+    keys.update(series.label_keys if series else {})
+    if not keys:
+        return series.label if series else "all cases"
+    return ", ".join(f"{key}={value}" for key, value in keys.items())
+
+
+def _end_time_text(series):
+    ends = {c.end_time for c in series.cases if math.isfinite(c.end_time)} if series else set()
+    return f"{ends.pop():g} (end)" if len(ends) == 1 else "end"
+
+
+def verdict_row(verdict):
+    """The table cells of one verdict."""
+    expect = verdict.expectation
+    order, tolerance = float(expect["order"]), float(expect["tolerance"])
+    fit = verdict.fit
+    observed = "-" if not math.isfinite(fit.order) else f"{fit.order:.3f}"
+    if math.isfinite(fit.ci_low):
+        observed += f" [{fit.ci_low:.2f}, {fit.ci_high:.2f}]"
+    used = [str(l.value) for l in verdict.levels if not l.reason]
+    limit = expect.get("max_error_constant")
+    constant = "-" if not math.isfinite(verdict.error_constant) else f"{verdict.error_constant:.3g}"
+    if limit is not None:
+        constant += f" <= {limit:g}"
+    return [
+        str(verdict.number),
+        expect["study"],
+        series_description(expect.get("where", {}), verdict.series),
+        expect["norm"],
+        f"{expect['time']:g}" if "time" in expect else _end_time_text(verdict.series),
+        ",".join(used) or "-",
+        observed,
+        f"[{order - tolerance:g}, {order + tolerance:g}]",
+        constant,
+        "PASS" if verdict.passed else "FAIL",
+        "; ".join(verdict.reasons or verdict.notes),
+    ]
+
+
+HEADER = ["#", "study", "series", "norm", "t", "levels", "observed order [95% CI]", "expected",
+          "E/h^p", "status", "reason"]
+
+
+def format_table(rows):
+    widths = [max(len(r[i]) for r in [HEADER] + rows) for i in range(len(HEADER))]
+    lines = ["  ".join(cell.ljust(width) for cell, width in zip(row, widths)).rstrip() for row in [HEADER] + rows]
+    lines.insert(1, "  ".join("-" * width for width in widths))
+    return "\n".join(lines)
+
+
+def summary_line(verdicts, expectation_count):
+    failed_expectations = len({v.number for v in verdicts if not v.passed})
+    failed_series = sum(not v.passed for v in verdicts)
+    if failed_expectations == 0:
+        return f"all {expectation_count} expectations hold ({len(verdicts)} series checked)"
+    return (f"{failed_expectations} of {expectation_count} expectations fell short "
+            f"({failed_series} of {len(verdicts)} series)")
+
+
+def gate(suite):
+    """All verdicts of a suite, in suite-file order."""
+    validate_expectations(suite)
+    return [v for number, expect in enumerate(suite.expectations, start=1)
+            for v in check_expectation(number, expect, suite)]
+
+
+class _OneLineParser(argparse.ArgumentParser):
+    def error(self, message):
+        self.exit(2, f"mpmvv gate: {message} (see --help)\n")
+
+
+def main(argv):
+    parser = _OneLineParser(prog="mpmvv gate", description=__doc__.split("\n\n")[0],
+                            epilog="Exit 0: every expectation holds; 1: one fell short; 2: bad directory or suite.")
+    parser.add_argument("directory", metavar="DIR", help="a suite output directory (mpmvv suite SUITE -o DIR)")
+    args = parser.parse_args(argv)
+    try:
+        suite = read_suite(args.directory)
+        if not suite.has_suite_file:
+            raise SuiteDirectoryError(f"{suite.directory / 'suite.toml'}: missing; "
+                                      "the gate needs the suite's [[expect]] tables")
+        verdicts = gate(suite)
+    except SuiteDirectoryError as error:
+        print(f"mpmvv gate: {error}", file=sys.stderr)
+        return 2
+    if not suite.expectations:
+        print(f"{suite.name}: no [[expect]] in suite.toml; nothing to check")
+        return 0
+    print(f"{suite.name}: {len(suite.expectations)} expectations")
+    print(format_table([verdict_row(v) for v in verdicts]))
+    print(summary_line(verdicts, len(suite.expectations)))
+    return 0 if all(v.passed for v in verdicts) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,98 @@
+"""The error norms of mpmvv, each defined once (reports/results-format.md, /errors).
+
+Probe-line norm, eq. 3.1 of 000_1dbcb8acb6dddab9.txt (Sandia SAND2015-7448):
+
+    L1 = sum_{i=1}^{N} |q_sim,i - q_exact,i| / N
+
+over the N material points of a probe line, for the line's quantity q (its
+``quantity`` attribute: angular displacement [rad], radial displacement or a
+displacement component [m]). The solver stores it as the column ``L1_<line>``
+of /errors; ``probe_line_l1`` recomputes it from the line's arrays <q> and
+exact_<q> (T x P), and ``stored_l1_discrepancy`` checks the two agree. A tracer
+that left the grid is NaN and makes the norm NaN at that time, as in the solver.
+
+Particle norms of the displacement error e_p = |x_p - x_exact(X_p, t)| [m],
+weighted by the reference volume V_p0 of each particle:
+
+    particle_L1   = sum_p V_p0 e_p / sum_p V_p0
+    particle_L2   = sqrt(sum_p V_p0 e_p^2 / sum_p V_p0)
+    particle_Linf = max_p e_p
+
+They need the exact motion at every particle, which only the solver evaluates,
+so the report reads them from /errors; ``volume_weighted_norms`` states the
+same definitions as code (and is tested on arrays whose norms are known).
+"""
+import numpy as np
+
+PARTICLE_NORMS = ("particle_L1", "particle_L2", "particle_Linf")
+
+QUANTITY_UNITS = {
+    "angular_displacement": "rad",
+    "radial_displacement": "m",
+    "displacement_x": "m",
+    "displacement_y": "m",
+}
+
+QUANTITY_LABELS = {
+    "angular_displacement": "angular displacement",
+    "radial_displacement": "radial displacement",
+    "displacement_x": "x (or r) displacement",
+    "displacement_y": "y (or z) displacement",
+}
+
+
+def probe_line_l1(simulated, exact):
+    """Eq. 3.1 at every output time: mean over the line's points of |q_sim - q_exact|.
+    simulated, exact: arrays T x P (or P); returns T values (or one)."""
+    return np.mean(np.abs(np.asarray(simulated, float) - np.asarray(exact, float)), axis=-1)
+
+
+def volume_weighted_norms(error, reference_volume):
+    """particle_L1, particle_L2, particle_Linf of the per-particle errors e_p
+    weighted by V_p0 (definitions in the module docstring)."""
+    e = np.asarray(error, float)
+    w = np.asarray(reference_volume, float)
+    total = w.sum()
+    return {
+        "particle_L1": float((w * e).sum() / total),
+        "particle_L2": float(np.sqrt((w * e * e).sum() / total)),
+        "particle_Linf": float(e.max()),
+    }
+
+
+def stored_l1_discrepancy(stored, recomputed):
+    """Largest relative difference between the stored /errors column and eq. 3.1
+    recomputed from the probe arrays; rows where both are NaN agree; 0 when empty."""
+    a = np.asarray(stored, float)
+    b = np.asarray(recomputed, float)
+    if a.shape != b.shape:
+        return float("inf")
+    both_nan = np.isnan(a) & np.isnan(b)
+    scale = np.maximum(np.abs(a), np.abs(b))
+    scale[scale == 0.0] = 1.0
+    difference = np.abs(a - b) / scale
+    difference[both_nan] = 0.0
+    return float(np.nan_to_num(difference, nan=np.inf).max()) if difference.size else 0.0
+
+
+def norm_unit(norm, line_quantities):
+    """Unit of an /errors column: m for particle norms, the line's quantity unit for L1_<line>."""
+    if norm in PARTICLE_NORMS:
+        return "m"
+    quantity = line_quantities.get(norm[len("L1_"):]) if norm.startswith("L1_") else None
+    return QUANTITY_UNITS.get(quantity, "")
+
+
+def describe_norm(norm, line_quantities):
+    """One line saying what an /errors column measures."""
+    if norm == "particle_L1":
+        return "volume-weighted mean particle displacement error"
+    if norm == "particle_L2":
+        return "volume-weighted RMS particle displacement error"
+    if norm == "particle_Linf":
+        return "largest particle displacement error"
+    if norm.startswith("L1_"):
+        line = norm[len("L1_"):]
+        quantity = QUANTITY_LABELS.get(line_quantities.get(line), "probe quantity")
+        return f"eq. 3.1 L1 of the {quantity} on probe line {line}"
+    return norm

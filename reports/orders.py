@@ -1,0 +1,210 @@
+"""Observed order of accuracy from errors on a sequence of meshes.
+
+An error that behaves as E(h) = C h^p on meshes of cell size h has
+
+* the pairwise order between consecutive levels i (coarser) and i + 1 (finer)
+      p_i = ln(E_i / E_{i+1}) / ln(h_i / h_{i+1});
+* the least-squares order: the slope p of the straight line
+      ln E = ln C + p ln h
+  fitted to all levels of the chosen range, with a two-sided confidence interval
+      p +- t(1 - (1 - c)/2, n - 2) * s / sqrt(sum (ln h_i - mean ln h)^2),
+  s^2 = (sum of squared residuals) / (n - 2), where t(q, nu) is the quantile of
+  Student's t distribution with nu degrees of freedom. The quantile is computed
+  here (no scipy): the t distribution function is written with the regularised
+  incomplete beta function, F(t) = 1 - I_x(nu/2, 1/2)/2 for t > 0 with
+  x = nu / (nu + t^2), evaluated by its continued fraction (modified Lentz), and
+  inverted by bisection.
+
+Classification of a range (the rule, applied in this order):
+
+* ``too few levels``: fewer than two usable levels;
+* ``stalled``: the last pairwise order (between the two finest levels) is below
+  STALLED_BELOW = 0.5: the error no longer falls with h;
+* ``non-asymptotic``: the pairwise orders span more than ASYMPTOTIC_SPREAD = 0.5
+  (max - min), so the range is not yet in the asymptotic regime where one
+  C h^p describes every level;
+* ``unchecked (2 levels)``: one pairwise order only, not stalled; nothing to
+  compare it with;
+* ``asymptotic`` otherwise.
+
+Richardson extrapolation and the grid convergence index (Roache, *Verification
+and Validation in Computational Science and Engineering*, 1998, ch. 5; Roache,
+"Perspective: a method for uniform reporting of grid refinement studies",
+J. Fluids Eng. 116 (1994) 405-413) for a quantity f without an exact value,
+from three levels with a constant refinement ratio r = h_coarse/h_medium =
+h_medium/h_fine, values f_3 (coarse), f_2 (medium), f_1 (fine):
+
+* convergence ratio   R = (f_2 - f_1) / (f_3 - f_2): ``monotone`` convergence
+  when 0 < R < 1, ``oscillatory`` when -1 < R < 0, ``divergent`` when |R| >= 1
+  (no order, extrapolation or GCI then), ``converged`` when f_2 = f_1;
+* observed order      p = ln(|f_3 - f_2| / |f_2 - f_1|) / ln r = -ln|R| / ln r;
+* extrapolated value  f_h=0 = f_1 + (f_1 - f_2) / (r^p - 1);
+* relative change     eps_21 = (f_2 - f_1) / f_1,  eps_32 = (f_3 - f_2) / f_2;
+* grid convergence index on the fine and medium levels, safety factor
+  F_s = 1.25 for three or more levels:
+      GCI_fine = F_s |eps_21| / (r^p - 1),   GCI_medium = F_s |eps_32| / (r^p - 1);
+* asymptotic-range check GCI_medium / (r^p GCI_fine), close to 1 in the
+  asymptotic range.
+"""
+import math
+from dataclasses import dataclass
+
+STALLED_BELOW = 0.5
+ASYMPTOTIC_SPREAD = 0.5
+GCI_SAFETY_FACTOR = 1.25
+
+
+def pairwise_orders(h, error):
+    """p_i = ln(E_i/E_{i+1}) / ln(h_i/h_{i+1}) for consecutive levels, coarse first.
+    NaN where an error is not positive or two cell sizes are equal."""
+    orders = []
+    for (h_coarse, e_coarse), (h_fine, e_fine) in zip(zip(h, error), zip(h[1:], error[1:])):
+        if e_coarse > 0 and e_fine > 0 and h_coarse > 0 and h_fine > 0 and h_coarse != h_fine:
+            orders.append(math.log(e_coarse / e_fine) / math.log(h_coarse / h_fine))
+        else:
+            orders.append(float("nan"))
+    return orders
+
+
+@dataclass(frozen=True)
+class OrderFit:
+    """Least-squares fit ln E = ln C + p ln h over n levels."""
+    order: float
+    error_constant: float      # C
+    ci_low: float              # confidence interval of p; NaN when n < 3
+    ci_high: float
+    confidence: float
+    levels: int
+
+
+def least_squares_order(h, error, confidence=0.95):
+    """Slope of ln E against ln h with its Student-t confidence interval.
+    Levels with a non-positive or non-finite error or h are left out."""
+    points = [(math.log(x), math.log(e)) for x, e in zip(h, error)
+              if x > 0 and e > 0 and math.isfinite(x) and math.isfinite(e)]
+    n = len(points)
+    nan = float("nan")
+    if n < 2:
+        return OrderFit(nan, nan, nan, nan, confidence, n)
+    mean_x = sum(x for x, _ in points) / n
+    mean_y = sum(y for _, y in points) / n
+    sxx = sum((x - mean_x) ** 2 for x, _ in points)
+    if sxx == 0.0:
+        return OrderFit(nan, nan, nan, nan, confidence, n)
+    slope = sum((x - mean_x) * (y - mean_y) for x, y in points) / sxx
+    intercept = mean_y - slope * mean_x
+    if n == 2:
+        return OrderFit(slope, math.exp(intercept), nan, nan, confidence, n)
+    residual = sum((y - intercept - slope * x) ** 2 for x, y in points)
+    standard_error = math.sqrt(residual / (n - 2) / sxx)
+    half_width = student_t_quantile(0.5 + confidence / 2.0, n - 2) * standard_error
+    return OrderFit(slope, math.exp(intercept), slope - half_width, slope + half_width, confidence, n)
+
+
+def classify(pairwise):
+    """The class of a refinement range from its pairwise orders (rule in the module docstring)."""
+    finite = [p for p in pairwise if math.isfinite(p)]
+    if not pairwise or not finite:
+        return "too few levels"
+    if not math.isfinite(pairwise[-1]) or pairwise[-1] < STALLED_BELOW:
+        return "stalled"
+    if len(finite) < 2:
+        return "unchecked (2 levels)"
+    if max(finite) - min(finite) > ASYMPTOTIC_SPREAD:
+        return "non-asymptotic"
+    return "asymptotic"
+
+
+def regularized_incomplete_beta(x, a, b):
+    """I_x(a, b) for 0 <= x <= 1, a, b > 0 by the continued fraction of
+    Numerical Recipes (3rd ed.) sec. 6.4, eq. 6.4.5, evaluated by modified Lentz,
+    on the side of the symmetry I_x(a, b) = 1 - I_{1-x}(b, a) where it converges fast."""
+    if x <= 0.0:
+        return 0.0
+    if x >= 1.0:
+        return 1.0
+    log_front = (math.lgamma(a + b) - math.lgamma(a) - math.lgamma(b)
+                 + a * math.log(x) + b * math.log1p(-x))
+    if x < (a + 1.0) / (a + b + 2.0):
+        return math.exp(log_front) * _beta_continued_fraction(x, a, b) / a
+    return 1.0 - math.exp(log_front) * _beta_continued_fraction(1.0 - x, b, a) / b
+
+
+def _beta_continued_fraction(x, a, b, tolerance=1e-15, max_terms=1000):
+    tiny = 1e-300
+    c = 1.0
+    d = 1.0 - (a + b) * x / (a + 1.0)
+    d = 1.0 / (d if abs(d) > tiny else tiny)
+    result = d
+    for m in range(1, max_terms + 1):
+        for numerator in (m * (b - m) * x / ((a + 2 * m - 1) * (a + 2 * m)),
+                          -(a + m) * (a + b + m) * x / ((a + 2 * m) * (a + 2 * m + 1))):
+            d = 1.0 + numerator * d
+            d = 1.0 / (d if abs(d) > tiny else tiny)
+            c = 1.0 + numerator / c
+            c = c if abs(c) > tiny else tiny
+            result *= c * d
+        if abs(c * d - 1.0) < tolerance:
+            return result
+    return result
+
+
+def student_t_cdf(t, dof):
+    """P(T <= t) for Student's t with dof degrees of freedom."""
+    tail = 0.5 * regularized_incomplete_beta(dof / (dof + t * t), 0.5 * dof, 0.5)
+    return 1.0 - tail if t > 0 else tail
+
+
+def student_t_quantile(probability, dof):
+    """t such that P(T <= t) = probability, by bisection on the distribution function."""
+    if not 0.0 < probability < 1.0:
+        raise ValueError(f"probability must lie in (0, 1), not {probability}")
+    if probability < 0.5:
+        return -student_t_quantile(1.0 - probability, dof)
+    low, high = 0.0, 1.0
+    while student_t_cdf(high, dof) < probability:
+        low, high = high, 2.0 * high
+    for _ in range(200):
+        middle = 0.5 * (low + high)
+        if student_t_cdf(middle, dof) < probability:
+            low = middle
+        else:
+            high = middle
+        if high - low <= 1e-13 * high:
+            break
+    return 0.5 * (low + high)
+
+
+def richardson_extrapolate(fine, coarse, ratio, order):
+    """f_h=0 = f_fine + (f_fine - f_coarse) / (r^p - 1)."""
+    return fine + (fine - coarse) / (ratio ** order - 1.0)
+
+
+@dataclass(frozen=True)
+class GridConvergence:
+    """Roache's three-level study of a quantity (definitions in the module docstring)."""
+    observed_order: float
+    convergence: str           # monotone | oscillatory | divergent | converged
+    extrapolated: float
+    gci_fine: float            # relative: multiply by |f_fine| for a band in the quantity's unit
+    gci_medium: float
+    asymptotic_ratio: float
+
+
+def grid_convergence(coarse, medium, fine, ratio, safety_factor=GCI_SAFETY_FACTOR):
+    """Observed order, Richardson extrapolation and GCI from three levels with a
+    constant refinement ratio r > 1."""
+    nan = float("nan")
+    change_fine, change_coarse = medium - fine, coarse - medium
+    if change_fine == 0.0:
+        return GridConvergence(nan, "converged", fine, 0.0, nan, nan)
+    if change_coarse == 0.0 or abs(change_fine / change_coarse) >= 1.0:
+        order = math.log(abs(change_coarse / change_fine)) / math.log(ratio) if change_coarse else nan
+        return GridConvergence(order, "divergent", nan, nan, nan, nan)
+    convergence = "monotone" if change_fine * change_coarse > 0 else "oscillatory"
+    order = math.log(abs(change_coarse / change_fine)) / math.log(ratio)
+    growth = ratio ** order - 1.0
+    gci_fine = safety_factor * abs(change_fine / fine) / growth if fine != 0.0 else nan
+    gci_medium = safety_factor * abs(change_coarse / medium) / growth if medium != 0.0 else nan
+    return GridConvergence(order, convergence, richardson_extrapolate(fine, medium, ratio, order),
+                           gci_fine, gci_medium, gci_medium / (ratio ** order * gci_fine))

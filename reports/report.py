@@ -1,0 +1,727 @@
+#!/usr/bin/python3
+"""Convergence report of a suite output directory, from its results files only.
+
+Usage: /usr/bin/python3 reports/report.py DIR [-o OUT]      (default OUT = DIR/report)
+
+Writes
+  OUT/report.html   self-contained (figures embedded as base64 PNG, no external links)
+  OUT/report.md     the same text, figures linked from OUT/figures/*.png
+  OUT/orders.csv    one row per (study, refinement series, error norm, output time)
+  OUT/gci.csv       Richardson extrapolation and GCI of each series' point-probe value
+
+The columns of orders.csv are ORDERS_CSV_COLUMNS below; the report states them.
+
+Norms are defined in reports/norms.py, orders, the classification rule and
+the GCI in reports/orders.py, refinement series in reports/series.py.
+"""
+import argparse
+import base64
+import csv
+import html
+import math
+import re
+import sys
+import textwrap
+import time as clock
+from dataclasses import dataclass
+from datetime import datetime
+from pathlib import Path
+
+import numpy as np
+
+import figures
+import gate
+import norms
+import orders
+from results import (SuiteDirectoryError, lookup_error, read_error_spectrum, read_point_history,
+                     read_probe_lines, read_suite)
+from series import DEFAULT_REFINE_KEY, refinement_series, series_levels, usable
+
+ORDERS_CSV_COLUMNS = (
+    ("study", "the study"),
+    ("series", "the keys that name the refinement series"),
+    ("norm", "an /errors column"),
+    ("unit", "its unit"),
+    ("time", "output time [s]"),
+    ("refine", "the key that refines"),
+    ("levels", "its values at the usable levels, coarse first, ';'-separated"),
+    ("h", "cell size at those levels [m]"),
+    ("error", "the norm at those levels"),
+    ("pairwise_orders", "orders between consecutive usable levels"),
+    ("ls_order", "least-squares order"),
+    ("ci_low", "lower end of its 95% Student-t interval (NaN with two levels)"),
+    ("ci_high", "upper end"),
+    ("classification", "asymptotic, non-asymptotic, stalled, unchecked (2 levels) or too few levels"),
+    ("finest_level", "refine value of the finest usable level"),
+    ("finest_h", "its cell size [m]"),
+    ("finest_error", "its error"),
+    ("left_out", "levels without a usable value at that time, and why"),
+)
+METHOD_KEYS = ("method", "scheme", "particles_per_direction", "cfl", "time_integration")
+PARAMETER_LABELS = {"reference_radius": "reference radius R [m]", "reference_r": "reference radius R [m]",
+                    "reference_x": "reference X [m]", "reference_y": "reference Y [m]",
+                    "reference_z": "reference Z [m]", "reference_position": "distance from the origin [m]"}
+
+
+# ---------------------------------------------------------------- numbers
+
+
+@dataclass(frozen=True)
+class OrderRow:
+    study: str
+    series: object               # series.Series
+    norm: str
+    unit: str
+    time: float
+    at_end: bool
+    levels: tuple                # usable series.Level, coarse first
+    left_out: tuple              # the others
+    pairwise: tuple
+    fit: orders.OrderFit
+    classification: str
+
+
+@dataclass(frozen=True)
+class GciRow:
+    study: str
+    series: object
+    probe: str
+    quantity: str
+    time: float
+    levels: tuple                # refine values, coarse first
+    values: tuple                # f_3, f_2, f_1
+    ratio: float
+    convergence: orders.GridConvergence
+    exact: float
+
+
+def refine_key(suite, study):
+    """The refine key of the study's first expectation that names one, else "cells"."""
+    return next((e["refine"] for e in suite.expectations if isinstance(e, dict) and e.get("study") == study
+                 and isinstance(e.get("refine"), str)), DEFAULT_REFINE_KEY)
+
+
+def study_series(suite, study):
+    return refinement_series(suite.cases_of(study), refine_key(suite, study))
+
+
+def expectation_times(suite, study):
+    return [float(e["time"]) for e in suite.expectations
+            if isinstance(e, dict) and e.get("study") == study and isinstance(e.get("time"), (int, float))]
+
+
+def error_columns(cases):
+    """Every /errors column of the cases, in first-seen order."""
+    return list(dict.fromkeys(name for c in cases if c.results for name in c.results.errors))
+
+
+def line_quantities(cases):
+    merged = {}
+    for case in cases:
+        if case.results:
+            merged.update(case.results.line_quantities)
+    return merged
+
+
+def series_end_time(series):
+    times = [c.end_time for c in series.cases if math.isfinite(c.end_time)]
+    return times[0] if times else float("nan")
+
+
+def order_row(series, norm, unit, time, at_end):
+    levels = series_levels(series, norm, time)
+    good = usable(levels)
+    h, error = [l.h for l in good], [l.error for l in good]
+    pairwise = orders.pairwise_orders(h, error)
+    return OrderRow(series.study, series, norm, unit, time, at_end, tuple(good),
+                    tuple(l for l in levels if l.reason), tuple(pairwise),
+                    orders.least_squares_order(h, error), orders.classify(pairwise))
+
+
+def order_rows(suite):
+    """Orders of every series of every study, for every norm, at the end time and
+    at each output time an expectation of the study names."""
+    rows = []
+    for study in suite.study_names():
+        cases = suite.cases_of(study)
+        quantities = line_quantities(cases)
+        for series in study_series(suite, study):
+            end = series_end_time(series)
+            times = [end] + [t for t in expectation_times(suite, study) if not math.isclose(t, end)]
+            for norm in error_columns(cases):
+                for t in dict.fromkeys(times):
+                    rows.append(order_row(series, norm, norms.norm_unit(norm, quantities), t, t == end))
+    return rows
+
+
+def gci_rows(suite):
+    """Roache's three-level study (reports/orders.py) of the point probe's simulated
+    value on the three finest completed levels of each series with a constant
+    refinement ratio, at the output time where the finest level's value is largest;
+    the exact value is kept only to check the GCI band."""
+    rows = []
+    for study in suite.study_names():
+        for series in study_series(suite, study):
+            row = gci_row(series)
+            if row is not None:
+                rows.append(row)
+    return rows
+
+
+def gci_row(series):
+    finest = [c for c in series.cases if c.completed and math.isfinite(c.h)][-3:]
+    if len(finest) < 3:
+        return None
+    ratio = finest[0].h / finest[1].h
+    if not math.isclose(ratio, finest[1].h / finest[2].h, rel_tol=1e-6):
+        return None
+    histories = [read_point_history(c.results_path) for c in finest]
+    if any(h is None or h.time.size == 0 for h in histories):
+        return None
+    output_times = np.asarray(finest[-1].attribute("output_times", []), float).ravel()
+    if output_times.size == 0:
+        output_times = np.asarray([finest[-1].end_time])
+    fine = histories[-1]
+    at = float(max(output_times, key=lambda t: abs(np.interp(t, fine.time, fine.simulated))))
+    values = tuple(float(np.interp(at, h.time, h.simulated)) for h in histories)
+    return GciRow(series.study, series, fine.name, fine.quantity, at,
+                  tuple(c.keys[series.refine] for c in finest), values, ratio,
+                  orders.grid_convergence(values[0], values[1], values[2], ratio),
+                  float(np.interp(at, fine.time, fine.exact)))
+
+
+def stored_norm_check(suite):
+    """(cases checked, largest relative difference) between eq. 3.1 recomputed from
+    the probe arrays and the stored L1_<line> columns."""
+    checked, largest = 0, 0.0
+    for case in suite.cases:
+        if case.results is None:
+            continue
+        for line in read_probe_lines(case.results_path):
+            stored = case.results.errors.get("L1_" + line.name)
+            if stored is not None:
+                recomputed = norms.probe_line_l1(line.simulated, line.exact)
+                largest = max(largest, norms.stored_l1_discrepancy(stored, recomputed[: stored.size]))
+        checked += 1
+    return checked, largest
+
+
+# ---------------------------------------------------------------- figures
+
+
+@dataclass(frozen=True)
+class FigureEntry:
+    study: str
+    path: Path
+    caption: str
+
+
+def split_label(series):
+    method = {k: v for k, v in series.label_keys.items() if k in METHOD_KEYS}
+    problem = {k: v for k, v in series.label_keys.items() if k not in METHOD_KEYS}
+    join = lambda keys: ", ".join(f"{k}={v}" for k, v in keys.items())  # noqa: E731
+    return join(method), join(problem)
+
+
+def series_styles(all_series):
+    """Colour by method settings, marker by problem keys, the same in every figure of a study."""
+    methods = list(dict.fromkeys(split_label(s)[0] for s in all_series))
+    problems = list(dict.fromkeys(split_label(s)[1] for s in all_series))
+    return {s.label: figures.Style(figures.COLOURS[methods.index(split_label(s)[0]) % len(figures.COLOURS)],
+                                   figures.MARKERS[problems.index(split_label(s)[1]) % len(figures.MARKERS)])
+            for s in all_series}
+
+
+def figure_norms(suite, study, cases):
+    """(norm, time or None for the end time) pairs drawn against h: those the study's
+    expectations name, the first probe line's L1 and particle_L2 at the end time
+    (an expectation's time equal to the study's one end time counts as the end time)."""
+    ends = {c.end_time for c in cases if math.isfinite(c.end_time)}
+    pairs = []
+    for e in suite.expectations:
+        if isinstance(e, dict) and e.get("study") == study and isinstance(e.get("norm"), str):
+            time = e.get("time")
+            explicit = isinstance(time, (int, float)) and not (len(ends) == 1 and math.isclose(time, min(ends)))
+            pairs.append((e["norm"], float(time) if explicit else None))
+    first_line = next(iter(line_quantities(cases)), None)
+    pairs += [(f"L1_{first_line}", None), ("particle_L2", None)] if first_line else [("particle_L2", None)]
+    columns = error_columns(cases)
+    return [p for p in dict.fromkeys(pairs) if p[0] in columns]
+
+
+def slug(*parts):
+    return re.sub(r"[^A-Za-z0-9_.=-]+", "_", "-".join(str(p) for p in parts)).strip("_")
+
+
+def time_text(t):
+    return f"t = {t:g} s"
+
+
+def error_figure(study, norm, time, rows, styles, quantities, directory):
+    chosen = [r for r in rows if r.study == study and r.norm == norm
+              and (r.at_end if time is None else math.isclose(r.time, time))]
+    if not chosen:
+        return None
+    times = sorted({r.time for r in chosen})
+    when = time_text(times[0]) if len(times) == 1 else "the end time"
+    curves = [figures.Curve(r.series.label, [l.h for l in r.levels], [l.error for l in r.levels],
+                            styles[r.series.label], r.fit) for r in chosen]
+    unit = chosen[0].unit
+    figure = figures.error_against_h(curves, f"{study}: {norm} at {when}", f"{norm} [{unit}]")
+    path = directory / f"{slug(study, 'error', norm, 'end' if time is None else time)}.png"
+    figures.save_png(figure, path)
+    missing = [r.series.label for r in chosen if not r.levels]
+    caption = (f"{study}: {norms.describe_norm(norm, quantities)} [{unit}] at {when} against cell size h; "
+               f"dashed: least-squares fit; grey: slopes 1 and 2.")
+    if missing:
+        caption += f" No usable level: {'; '.join(missing)}."
+    return FigureEntry(study, path, caption)
+
+
+def work_precision_figure(study, all_series, norm, unit, styles, directory):
+    panels = {}
+    for series in all_series:
+        method, problem = split_label(series)
+        points = [(c.wall_time_s, lookup_error(c, norm, c.end_time)[0]) for c in series.cases if c.completed]
+        curve = figures.Curve(method or series.label, [p[0] for p in points], [p[1] for p in points],
+                              styles[series.label])
+        panels.setdefault(problem, []).append(curve)
+    end = series_end_time(all_series[0])
+    figure = figures.work_precision(list(panels.items()), f"{study}: work against precision, {norm} at the end "
+                                    f"time", f"{norm} at t = {end:g} s [{unit}]")
+    path = directory / f"{slug(study, 'work-precision')}.png"
+    figures.save_png(figure, path)
+    return FigureEntry(study, path, f"{study}: {norm} at the end time against wall time of the time loop for the "
+                                    f"completed cases, one curve per method setting across "
+                                    f"{all_series[0].refine}; circled: Pareto front (no case is both faster and "
+                                    f"more accurate).")
+
+
+def stability_cell(case):
+    if case.results is None:
+        return figures.StabilityCell(float("nan"), case.status, stopped=True)
+    reached = case.time_reached
+    if case.completed:
+        return figures.StabilityCell(1.0, f"{reached:.3g} s\ncompleted")
+    fraction = reached / case.end_time if case.end_time > 0 else float("nan")
+    reason = textwrap.fill(case.failure_reason or case.status, 14)
+    return figures.StabilityCell(min(max(fraction, 0.0), 1.0), f"{reached:.3g} s\n{reason}", stopped=True)
+
+
+def stability_figure(study, all_series, directory):
+    refine = all_series[0].refine
+    columns = sorted({c.keys[refine] for s in all_series for c in s.cases}, key=_sort_value)
+    panels = {}
+    for series in all_series:
+        method, problem = split_label(series)
+        panel = panels.setdefault(problem, figures.StabilityPanel(problem, columns, [], {}))
+        row = method or series.label
+        panel.rows.append(row)
+        for case in series.cases:
+            panel.cells[(row, case.keys[refine])] = stability_cell(case)
+    end = series_end_time(all_series[0])
+    figure = figures.stability_map(list(panels.values()), f"{study}: time reached [s] of end time {end:g} s and "
+                                   f"why a run stopped", refine)
+    path = directory / f"{slug(study, 'stability')}.png"
+    figures.save_png(figure, path)
+    return FigureEntry(study, path, f"{study}: how far each case got (cf. table 3.2 of 000_1dbcb8acb6dddab9.txt): "
+                                    f"time reached and failure reason; hatched: stopped before the end time; "
+                                    f"grey: no results (status shown).")
+
+
+def _sort_value(value):
+    return (0, value, "") if isinstance(value, (int, float)) else (1, 0, str(value))
+
+
+def finest_completed(series):
+    done = [c for c in series.cases if c.completed]
+    return done[-1] if done else None
+
+
+def profile_snapshots(line):
+    """The last output and, when different, the output where the exact profile is
+    largest (at the last output the exact motion may be at rest, as the ring's is)."""
+    last = line.time.size - 1
+    largest = int(np.nanargmax(np.nanmax(np.abs(line.exact), axis=1)))
+    chosen = [last] if largest == last else [largest, last]
+    return [figures.Snapshot(time_text(line.time[k]) if len(chosen) > 1 else "", line.simulated[k], line.exact[k])
+            for k in chosen]
+
+
+def profile_figure(study, all_series, directory):
+    panels, line = [], None
+    for series in all_series:
+        case = finest_completed(series)
+        lines = read_probe_lines(case.results_path) if case else []
+        if not lines or lines[0].time.size == 0:
+            continue
+        line = lines[0]
+        panels.append(figures.ProfilePanel(f"{series.label}\n{case.keys[series.refine]} {series.refine}",
+                                           line.positions, profile_snapshots(line)))
+    if not panels:
+        return None
+    unit = norms.QUANTITY_UNITS.get(line.quantity, "")
+    label = norms.QUANTITY_LABELS.get(line.quantity, line.quantity)
+    figure = figures.profiles(panels, f"{study}: {label} along probe line {line.name}",
+                              PARAMETER_LABELS.get(line.parameter, line.parameter), f"{label} [{unit}]", unit)
+    path = directory / f"{slug(study, 'profile', line.name)}.png"
+    figures.save_png(figure, path)
+    return FigureEntry(study, path, f"{study}: simulated (markers) and exact (lines) {label} along probe line "
+                                    f"{line.name} at the last output and where the exact profile is largest, finest "
+                                    f"completed case of each series; below: simulated - exact.")
+
+
+def history_figure(study, all_series, directory):
+    panels, history = [], None
+    for series in all_series:
+        case = finest_completed(series)
+        found = read_point_history(case.results_path) if case else None
+        if found is None or found.time.size == 0:
+            continue
+        history = found
+        where = ", ".join(f"{x:.3g}" for x in np.ravel(history.reference_position))
+        panels.append(figures.ProfilePanel(f"{series.label}\n{case.keys[series.refine]} {series.refine}, "
+                                           f"point ({where}) m", history.time,
+                                           [figures.Snapshot("", history.simulated, history.exact)]))
+    if not panels:
+        return None
+    unit = norms.QUANTITY_UNITS.get(history.quantity, "")
+    label = norms.QUANTITY_LABELS.get(history.quantity, history.quantity)
+    figure = figures.profiles(panels, f"{study}: {label} at material point {history.name} over time",
+                              "time t [s]", f"{label} [{unit}]", unit, markers=False)
+    path = directory / f"{slug(study, 'history', history.name)}.png"
+    figures.save_png(figure, path)
+    return FigureEntry(study, path, f"{study}: {label} at material point {history.name} after every step, finest "
+                                    f"completed case of each series, against the exact motion; below: "
+                                    f"simulated - exact.")
+
+
+def spectrum_figure(study, all_series, styles, directory):
+    panels, quantity = {}, ""
+    for series in all_series:
+        candidates = [c for c in series.cases if c.results is not None]
+        chosen = next(((c, s) for c in reversed(candidates) for s in [read_error_spectrum(c.results_path)] if s),
+                      None)
+        if chosen is None:
+            continue
+        case, spectrum = chosen
+        quantity = spectrum.quantity
+        method, problem = split_label(series)
+        label = (f"{method or series.label}, {case.keys[series.refine]} {series.refine}, "
+                 f"{time_text(spectrum.time[-1])}")
+        if not case.completed:
+            label += f" ({case.status})"
+        curve = figures.Curve(label, np.arange(spectrum.amplitude.shape[1]), spectrum.amplitude[-1],
+                              styles[series.label])
+        panels.setdefault(problem, []).append(curve)
+    if not panels:
+        return None
+    unit = norms.QUANTITY_UNITS.get(quantity, "")
+    label = norms.QUANTITY_LABELS.get(quantity, quantity)
+    figure = figures.error_spectra(list(panels.items()), f"{study}: angular spectrum of the {label} error on the "
+                                   f"material circle at the last output", f"amplitude of mode m [{unit}]")
+    path = directory / f"{slug(study, 'spectrum')}.png"
+    figures.save_png(figure, path)
+    return FigureEntry(study, path, f"{study}: amplitude of angular mode m of the {label} error around the material "
+                                    f"circle (/probes/circle/error_spectrum) at the last output, finest case of each "
+                                    f"series that has one; the exact motion is axisymmetric, so m > 0 is lost "
+                                    f"axisymmetry.")
+
+
+def study_figures(suite, study, rows, directory):
+    cases = suite.cases_of(study)
+    all_series = study_series(suite, study)
+    if not all_series:
+        return []
+    styles = series_styles(all_series)
+    quantities = line_quantities(cases)
+    pairs = figure_norms(suite, study, cases)
+    entries = [error_figure(study, norm, t, rows, styles, quantities, directory) for norm, t in pairs]
+    if pairs:
+        norm = pairs[0][0]
+        entries.append(work_precision_figure(study, all_series, norm, norms.norm_unit(norm, quantities), styles,
+                                             directory))
+    entries.append(stability_figure(study, all_series, directory))
+    entries.append(profile_figure(study, all_series, directory))
+    entries.append(history_figure(study, all_series, directory))
+    entries.append(spectrum_figure(study, all_series, styles, directory))
+    return [e for e in entries if e is not None]
+
+
+# ---------------------------------------------------------------- tables
+
+
+@dataclass(frozen=True)
+class Table:
+    headers: list
+    rows: list                   # lists of strings
+    css: list = None             # optional CSS class per row
+
+
+def number(value, spec=".3g"):
+    return "-" if value is None or not math.isfinite(value) else format(value, spec)
+
+
+def case_table(suite):
+    rows, css = [], []
+    for c in suite.cases:
+        reached = f"{number(c.time_reached)} / {number(c.end_time)}"
+        rows.append([c.id, c.status, reached, "" if c.completed else c.failure_reason, number(c.wall_time_s),
+                     number(c.attribute("steps"), "g"), number(c.attribute("particle_count"), "g")])
+        css.append(c.status)
+    return Table(["case", "status", "reached / end time [s]", "failure reason", "wall time [s]", "steps",
+                  "particles"], rows, css)
+
+
+def order_cells(row):
+    fit = row.fit
+    ci = f" [{fit.ci_low:.2f}, {fit.ci_high:.2f}]" if math.isfinite(fit.ci_low) else ""
+    finest = row.levels[-1] if row.levels else None
+    return [row.study, row.series.label, f"{row.norm} [{row.unit}]", f"{row.time:g}",
+            ", ".join(str(l.value) for l in row.levels) or "-",
+            number(finest.error) if finest else "-",
+            ", ".join(number(p, ".2f") for p in row.pairwise) or "-",
+            (number(fit.order, ".3f") + ci) if math.isfinite(fit.order) else "-",
+            row.classification]
+
+
+def orders_table(rows):
+    return Table(["study", "series", "norm", "t [s]", "levels", "finest error", "pairwise orders",
+                  "least-squares order [95% CI]", "class"], [order_cells(r) for r in rows],
+                 [r.classification.split()[0] for r in rows])
+
+
+def gci_table(rows):
+    cells = []
+    for r in rows:
+        g = r.convergence
+        band = abs(r.values[-1]) * g.gci_fine
+        error = abs(r.values[-1] - r.exact)
+        cells.append([r.study, r.series.label, f"{r.probe} {r.quantity}", f"{r.time:g}",
+                      ", ".join(str(v) for v in r.levels), ", ".join(number(v, ".6g") for v in r.values),
+                      number(g.observed_order, ".2f"), g.convergence, number(g.extrapolated, ".6g"),
+                      number(100 * g.gci_fine, ".3g"), number(g.asymptotic_ratio, ".3f"),
+                      number(r.exact, ".6g"), "yes" if error <= band else "no"])
+    return Table(["study", "series", "quantity", "t [s]", "levels", "values (coarse to fine)", "observed p",
+                  "convergence", "extrapolated", "GCI fine [%]", "asymptotic ratio", "exact (check)",
+                  "exact within GCI band"], cells)
+
+
+def expectation_table(verdicts):
+    return Table(gate.HEADER, [gate.verdict_row(v) for v in verdicts],
+                 ["PASS" if v.passed else "FAIL" for v in verdicts])
+
+
+def _joined(values):
+    return ";".join(repr(float(v)) for v in values)
+
+
+def write_orders_csv(rows, path):
+    with open(path, "w", newline="") as stream:
+        writer = csv.writer(stream)
+        writer.writerow([name for name, _ in ORDERS_CSV_COLUMNS])
+        for r in rows:
+            finest = r.levels[-1] if r.levels else None
+            writer.writerow([r.study, r.series.label, r.norm, r.unit, repr(r.time), r.series.refine,
+                             ";".join(str(l.value) for l in r.levels), _joined(l.h for l in r.levels),
+                             _joined(l.error for l in r.levels), _joined(r.pairwise), repr(r.fit.order),
+                             repr(r.fit.ci_low), repr(r.fit.ci_high), r.classification,
+                             finest.value if finest else "", repr(finest.h) if finest else "",
+                             repr(finest.error) if finest else "",
+                             ";".join(f"{l.value}: {l.reason}" for l in r.left_out)])
+
+
+def write_gci_csv(rows, path):
+    with open(path, "w", newline="") as stream:
+        writer = csv.writer(stream)
+        writer.writerow(["study", "series", "probe", "quantity", "time", "levels", "f_coarse", "f_medium", "f_fine",
+                         "ratio", "observed_order", "convergence", "extrapolated", "gci_fine", "gci_medium",
+                         "asymptotic_ratio", "exact"])
+        for r in rows:
+            g = r.convergence
+            writer.writerow([r.study, r.series.label, r.probe, r.quantity, repr(r.time),
+                             ";".join(str(v) for v in r.levels), *map(repr, r.values), repr(r.ratio),
+                             repr(g.observed_order), g.convergence, repr(g.extrapolated), repr(g.gci_fine),
+                             repr(g.gci_medium), repr(g.asymptotic_ratio), repr(r.exact)])
+
+
+# ---------------------------------------------------------------- documents
+
+
+@dataclass(frozen=True)
+class Report:
+    suite: object
+    generated: datetime
+    status_counts: dict
+    norm_check: tuple
+    order_rows: list
+    gci_rows: list
+    sections: list               # (title, paragraph, Table or None)
+    figures: list                # FigureEntry
+
+
+def status_counts(suite):
+    counts = {}
+    for case in suite.cases:
+        counts[case.status] = counts.get(case.status, 0) + 1
+    return counts
+
+
+DEFINITIONS = (
+    "Norms: L1_<line> is eq. 3.1 of 000_1dbcb8acb6dddab9.txt, the mean over a probe line's material points of "
+    "|q_sim - q_exact|; particle_L1, particle_L2 and particle_Linf are the reference-volume-weighted mean, RMS and "
+    "maximum of the particle displacement error |x_p - x_exact(X_p, t)| (reports/norms.py). Orders: pairwise "
+    "p = ln(E_i/E_i+1)/ln(h_i/h_i+1) between consecutive usable levels; least-squares slope of ln E against ln h with "
+    "a 95% Student-t interval (none with two levels). Class: stalled when the finest pairwise order is below "
+    f"{orders.STALLED_BELOW}; non-asymptotic when the pairwise orders span more than {orders.ASYMPTOTIC_SPREAD}; "
+    "unchecked with one pair; asymptotic otherwise. A level is usable when its case wrote the norm at that time "
+    "(a failed run keeps the outputs it reached).")
+
+
+def build_report(suite, figure_directory):
+    rows, grid_rows = order_rows(suite), gci_rows(suite)
+    sections = [("Cases", "Status from manifest.json; time reached, failure reason, wall time of the time loop, "
+                 "steps and particle count from each results file.", case_table(suite))]
+    if suite.expectations:
+        try:
+            verdicts = gate.gate(suite)
+            summary = gate.summary_line(verdicts, len(suite.expectations))
+            sections.append(("Expectations", f"As checked by mpmvv gate: {summary}.", expectation_table(verdicts)))
+        except SuiteDirectoryError as error:
+            sections.append(("Expectations", f"Not checked: {error}", None))
+    fitted = [r for r in rows if len(r.levels) >= 2]
+    sections.append(("Observed orders", DEFINITIONS + f" {len(rows) - len(fitted)} of {len(rows)} (series, norm, "
+                     "time) combinations have fewer than two usable levels and are left out here. orders.csv has "
+                     "every row, with the columns " + "; ".join(f"{n} ({m})" for n, m in ORDERS_CSV_COLUMNS) + ".",
+                     orders_table(fitted)))
+    sections.append(("Richardson extrapolation and grid convergence index",
+                     "Roache's GCI (safety factor 1.25) of the point probe's simulated value on the three finest "
+                     "completed levels of each series with a constant refinement ratio, at the output time where the "
+                     "finest value is largest in magnitude, treated as a quantity without an exact value; the exact "
+                     "value is shown only to check the band f_fine (1 +- GCI).", gci_table(grid_rows)))
+    entries = [e for study in suite.study_names() for e in study_figures(suite, study, rows, figure_directory)]
+    return Report(suite, datetime.now(), status_counts(suite), stored_norm_check(suite), rows, grid_rows,
+                  sections, entries)
+
+
+def header_lines(report):
+    suite = report.suite
+    counts = ", ".join(f"{n} {s}" for s, n in report.status_counts.items())
+    checked, largest = report.norm_check
+    return [
+        suite.description or "(no description in suite.toml)",
+        f"Directory {suite.directory}; manifest written {suite.written:%Y-%m-%d %H:%M}; report generated "
+        f"{report.generated:%Y-%m-%d %H:%M}.",
+        f"{len(suite.cases)} cases: {counts}.",
+        f"Eq. 3.1 recomputed from the probe arrays of {checked} results files agrees with the stored L1 columns to "
+        f"{largest:.1e} (relative).",
+    ]
+
+
+CSS = """
+body { font-family: sans-serif; margin: 1.5em auto; max-width: 1400px; color: #222; }
+table { border-collapse: collapse; font-size: 0.85em; margin: 0.5em 0 1.5em; }
+th, td { border: 1px solid #ccc; padding: 2px 6px; text-align: left; vertical-align: top; }
+th { background: #f0f0f0; position: sticky; top: 0; }
+tr.completed td:nth-child(2), tr.PASS td:nth-child(10), tr.asymptotic td:last-child { color: #1a7f37; }
+tr.failed td:nth-child(2), tr.crashed td:nth-child(2), tr.timeout td:nth-child(2), tr.error td:nth-child(2),
+tr.FAIL td:nth-child(10), tr.stalled td:last-child { color: #c62828; font-weight: bold; }
+tr.pending td:nth-child(2), tr.non-asymptotic td:last-child { color: #9a6700; }
+figure { margin: 1em 0 2em; } figure img { max-width: 100%; border: 1px solid #eee; }
+figcaption { font-size: 0.9em; color: #444; }
+"""
+
+
+def html_table(table):
+    head = "".join(f"<th>{html.escape(h)}</th>" for h in table.headers)
+    body = []
+    for index, row in enumerate(table.rows):
+        css = f' class="{html.escape(table.css[index])}"' if table.css else ""
+        body.append(f"<tr{css}>" + "".join(f"<td>{html.escape(cell)}</td>" for cell in row) + "</tr>")
+    return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
+
+
+def render_html(report):
+    suite = report.suite
+    parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(suite.name)}</title>"
+             f"<style>{CSS}</style></head><body><h1>Convergence report: {html.escape(suite.name)}</h1>"]
+    parts += [f"<p>{html.escape(line)}</p>" for line in header_lines(report)]
+    for title, text, table in report.sections:
+        parts.append(f"<h2>{html.escape(title)}</h2><p>{html.escape(text)}</p>")
+        parts.append(html_table(table) if table and table.rows else "<p><em>none</em></p>")
+    parts.append("<h2>Figures</h2>")
+    for study in dict.fromkeys(e.study for e in report.figures):
+        parts.append(f"<h3>{html.escape(study)}</h3>")
+        for entry in (e for e in report.figures if e.study == study):
+            data = base64.b64encode(entry.path.read_bytes()).decode()
+            parts.append(f"<figure><img alt='{html.escape(entry.path.name)}' src='data:image/png;base64,{data}'>"
+                         f"<figcaption>{html.escape(entry.caption)}</figcaption></figure>")
+    parts.append("</body></html>")
+    return "\n".join(parts)
+
+
+def markdown_table(table):
+    escape = lambda cell: cell.replace("|", "\\|").replace("\n", " ")  # noqa: E731
+    lines = ["| " + " | ".join(table.headers) + " |", "|" + "---|" * len(table.headers)]
+    lines += ["| " + " | ".join(escape(cell) for cell in row) + " |" for row in table.rows]
+    return "\n".join(lines)
+
+
+def render_markdown(report, output_directory):
+    lines = [f"# Convergence report: {report.suite.name}", ""]
+    lines += [line + "\n" for line in header_lines(report)]
+    for title, text, table in report.sections:
+        lines += [f"## {title}", "", text, "", markdown_table(table) if table and table.rows else "_none_", ""]
+    lines += ["## Figures", ""]
+    for study in dict.fromkeys(e.study for e in report.figures):
+        lines += [f"### {study}", ""]
+        for entry in (e for e in report.figures if e.study == study):
+            lines += [f"![{entry.caption}]({entry.path.relative_to(output_directory).as_posix()})", "",
+                      f"_{entry.caption}_", ""]
+    return "\n".join(lines)
+
+
+def write_report(directory, output=None):
+    """Read the suite, write every output; returns the paths written."""
+    suite = read_suite(directory)
+    output = Path(output) if output else suite.directory / "report"
+    figure_directory = output / "figures"
+    figure_directory.mkdir(parents=True, exist_ok=True)
+    for old in figure_directory.glob("*.png"):
+        old.unlink()
+    report = build_report(suite, figure_directory)
+    written = {"html": output / "report.html", "markdown": output / "report.md",
+               "orders": output / "orders.csv", "gci": output / "gci.csv"}
+    written["html"].write_text(render_html(report))
+    written["markdown"].write_text(render_markdown(report, output))
+    write_orders_csv(report.order_rows, written["orders"])
+    write_gci_csv(report.gci_rows, written["gci"])
+    return written, len(report.figures)
+
+
+class _OneLineParser(argparse.ArgumentParser):
+    def error(self, message):
+        self.exit(2, f"mpmvv report: {message} (see --help)\n")
+
+
+def main(argv):
+    parser = _OneLineParser(prog="mpmvv report", description="Tables, figures and report.html of a suite output "
+                            "directory, from its results files only.")
+    parser.add_argument("directory", metavar="DIR", help="a suite output directory (mpmvv suite SUITE -o DIR)")
+    parser.add_argument("-o", "--output", metavar="OUT", help="where to write (default DIR/report)")
+    args = parser.parse_args(argv)
+    start = clock.perf_counter()
+    try:
+        written, figure_count = write_report(args.directory, args.output)
+    except SuiteDirectoryError as error:
+        print(f"mpmvv report: {error}", file=sys.stderr)
+        return 2
+    for path in written.values():
+        print(f"wrote {path}")
+    print(f"{figure_count} figures in {written['html'].parent / 'figures'}; "
+          f"{clock.perf_counter() - start:.1f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

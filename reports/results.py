@@ -1,0 +1,287 @@
+"""Read a suite output directory (suites/README.md, "The output directory") and
+the results files in it (reports/results-format.md).
+
+    DIR/manifest.json        every case: id, study, resolved keys, status, results path
+    DIR/suite.toml           the suite as run: [[study]] and [[expect]] tables
+    DIR/cases/<id>.h5        one results file per case that ran
+
+A case's status is the manifest's (completed, failed, crashed, timeout, error,
+pending). A case without a readable results file (pending, crashed, timeout,
+error, or a damaged file) is kept with ``results = None`` and a note saying why,
+so that every report and the gate can show it instead of stopping on it.
+Only root attributes and /errors are read up front; probe arrays are read on
+demand for the few cases that are plotted.
+"""
+import json
+import math
+import tomllib
+from dataclasses import dataclass, field
+from datetime import datetime
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+CASE_STATUSES = ("completed", "failed", "crashed", "timeout", "error", "pending")
+TIME_MATCH_TOLERANCE = 1e-9   # relative; output times are written from the same decimal values
+
+
+class SuiteDirectoryError(Exception):
+    """A directory that is not a readable suite output directory; the message is one line."""
+
+
+@dataclass(frozen=True)
+class CaseResults:
+    """What a results file holds besides its probe and particle arrays."""
+    attributes: dict
+    error_times: np.ndarray
+    errors: dict                  # /errors column name -> values at error_times
+    line_quantities: dict         # probe line name -> its 'quantity' attribute
+
+
+@dataclass(frozen=True)
+class Case:
+    id: str
+    study: str
+    keys: dict
+    status: str
+    detail: str
+    results_path: Path
+    manifest_wall_time_s: float = float("nan")
+    results: CaseResults = None
+    note: str = ""                # why there are no results, when there are none
+
+    def attribute(self, name, default=float("nan")):
+        if self.results is not None and name in self.results.attributes:
+            return self.results.attributes[name]
+        return default
+
+    @property
+    def h(self):
+        return float(self.attribute("h"))
+
+    @property
+    def end_time(self):
+        return float(self.keys.get("end_time", self.attribute("end_time")))
+
+    @property
+    def time_reached(self):
+        return float(self.attribute("time_reached"))
+
+    @property
+    def failure_reason(self):
+        reason = self.attribute("failure_reason", "")
+        return reason or self.detail or self.note
+
+    @property
+    def wall_time_s(self):
+        """The time loop's wall time from the results file; else the process's from the manifest."""
+        return float(self.attribute("wall_time_s", self.manifest_wall_time_s))
+
+    @property
+    def completed(self):
+        return self.status == "completed" and self.results is not None
+
+
+@dataclass(frozen=True)
+class Suite:
+    directory: Path
+    name: str
+    description: str
+    written: datetime
+    has_suite_file: bool
+    studies: list = field(default_factory=list)        # [[study]] tables of suite.toml
+    expectations: list = field(default_factory=list)   # [[expect]] tables of suite.toml
+    cases: list = field(default_factory=list)
+
+    def study_names(self):
+        names = [s.get("name") for s in self.studies if isinstance(s.get("name"), str)]
+        return names + sorted({c.study for c in self.cases} - set(names), key=[c.study for c in self.cases].index)
+
+    def cases_of(self, study):
+        return [c for c in self.cases if c.study == study]
+
+
+def read_suite(directory):
+    """Read DIR/manifest.json, DIR/suite.toml (optional here) and every case's results."""
+    directory = Path(directory)
+    if not directory.is_dir():
+        raise SuiteDirectoryError(f"{directory}: no such directory")
+    manifest_path = directory / "manifest.json"
+    manifest = _read_manifest(manifest_path)
+    suite_path = directory / "suite.toml"
+    suite_file = _read_suite_file(suite_path) if suite_path.is_file() else {}
+    studies = suite_file.get("study", [])
+    expectations = suite_file.get("expect", [])
+    if not isinstance(studies, list) or not isinstance(expectations, list):
+        raise SuiteDirectoryError(f"{suite_path}: 'study' and 'expect' must be arrays of tables "
+                                  "([[study]], [[expect]])")
+    return Suite(
+        directory=directory,
+        name=str(manifest.get("suite", directory.name)),
+        description=str(suite_file.get("description", manifest.get("description", ""))),
+        written=datetime.fromtimestamp(manifest_path.stat().st_mtime),
+        has_suite_file=suite_path.is_file(),
+        studies=studies,
+        expectations=expectations,
+        cases=[_read_case(directory, entry) for entry in manifest["cases"]],
+    )
+
+
+def _read_manifest(path):
+    if not path.is_file():
+        raise SuiteDirectoryError(f"{path}: missing; not a suite output directory (mpmvv suite SUITE -o DIR writes it)")
+    try:
+        manifest = json.loads(path.read_text())
+    except (json.JSONDecodeError, UnicodeDecodeError) as error:
+        raise SuiteDirectoryError(f"{path}: not valid JSON ({error})") from None
+    if not isinstance(manifest, dict) or not isinstance(manifest.get("cases"), list):
+        raise SuiteDirectoryError(f"{path}: expected an object with a 'cases' array")
+    for index, entry in enumerate(manifest["cases"]):
+        named = isinstance(entry, dict) and isinstance(entry.get("id"), str) and isinstance(entry.get("study"), str)
+        if not named:
+            raise SuiteDirectoryError(f"{path}: case {index} needs string 'id' and 'study'")
+        if not isinstance(entry.get("keys", {}), dict):
+            raise SuiteDirectoryError(f"{path}: case '{entry['id']}': 'keys' must be an object")
+    return manifest
+
+
+def _read_suite_file(path):
+    try:
+        return tomllib.loads(path.read_text())
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
+        raise SuiteDirectoryError(f"{path}: not valid TOML ({error})") from None
+
+
+def _read_case(directory, entry):
+    results_path = directory / entry.get("results", f"cases/{entry['id']}.h5")
+    wall_time = entry.get("wall_time_s")
+    results, note = None, ""
+    if results_path.is_file():
+        try:
+            results = read_case_results(results_path)
+        except (OSError, KeyError, ValueError, TypeError) as error:
+            note = f"unreadable results file ({error})"
+    elif entry.get("status") not in ("pending", None):
+        note = "no results file"
+    status = entry.get("status")
+    if status not in CASE_STATUSES:
+        status = results.attributes.get("status", "pending") if results is not None else "pending"
+    return Case(id=entry["id"], study=entry["study"], keys=dict(entry.get("keys", {})), status=status,
+                detail=str(entry.get("detail", "")), results_path=results_path,
+                manifest_wall_time_s=float(wall_time) if isinstance(wall_time, (int, float)) else float("nan"),
+                results=results, note=note)
+
+
+def _plain(value):
+    if isinstance(value, bytes):
+        return value.decode()
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def read_case_results(path):
+    """Root attributes, /errors and the probe lines' quantities of one results file."""
+    with h5py.File(path, "r") as f:
+        attributes = {name: _plain(value) for name, value in f.attrs.items()}
+        errors_group = f.get("errors")
+        errors, error_times = {}, np.zeros(0)
+        if errors_group is not None:
+            error_times = np.asarray(errors_group["time"][:], float) if "time" in errors_group else np.zeros(0)
+            errors = {name: np.asarray(errors_group[name][:], float) for name in errors_group if name != "time"}
+        line_quantities = {}
+        for name, group in f.get("probes", {}).items():
+            quantity = _plain(group.attrs.get("quantity", ""))
+            if name != "circle" and quantity in group and group[quantity].ndim == 2:
+                line_quantities[name] = quantity
+    return CaseResults(attributes, error_times, errors, line_quantities)
+
+
+def lookup_error(case, norm, time):
+    """(E, "") for the error column `norm` at output time `time`, or (NaN, why not)."""
+    nan = float("nan")
+    if case.results is None:
+        return nan, f"{case.status}" + (f": {case.failure_reason}" if case.failure_reason else "")
+    if norm not in case.results.errors:
+        return nan, f"no /errors column '{norm}'"
+    times = case.results.error_times
+    hits = np.nonzero(np.abs(times - time) <= TIME_MATCH_TOLERANCE * max(1.0, abs(time)))[0]
+    column = case.results.errors[norm]
+    if hits.size == 0 or hits[0] >= column.size:
+        return nan, f"no output at t = {time:g} (reached {case.time_reached:.4g})"
+    value = float(column[hits[0]])
+    if not math.isfinite(value):
+        return nan, f"{norm} is {value} at t = {time:g}"
+    return value, ""
+
+
+@dataclass(frozen=True)
+class ProbeLine:
+    name: str
+    quantity: str
+    parameter: str                # e.g. reference_radius
+    positions: np.ndarray         # P values of the parameter [m]
+    time: np.ndarray              # T output times
+    simulated: np.ndarray         # T x P
+    exact: np.ndarray             # T x P
+
+
+@dataclass(frozen=True)
+class PointHistory:
+    name: str
+    quantity: str
+    reference_position: np.ndarray
+    time: np.ndarray              # S step times
+    simulated: np.ndarray
+    exact: np.ndarray
+
+
+@dataclass(frozen=True)
+class ErrorSpectrum:
+    quantity: str
+    reference_radius: float
+    time: np.ndarray              # T output times
+    amplitude: np.ndarray         # T x (M/2 + 1): one-sided amplitude of mode m of the error
+
+
+def read_probe_lines(path):
+    """Every probe line of a results file, in the file's group order."""
+    lines = []
+    with h5py.File(path, "r") as f:
+        for name, group in f.get("probes", {}).items():
+            quantity = _plain(group.attrs.get("quantity", ""))
+            if name == "circle" or quantity not in group or group[quantity].ndim != 2:
+                continue
+            parameter = next((p for p in group if p.startswith("reference_") and p != "reference_position"),
+                             "reference_position")
+            positions = np.asarray(group[parameter][:], float)
+            if positions.ndim == 2:
+                positions = np.hypot(positions[:, 0], positions[:, 1])
+            lines.append(ProbeLine(name, quantity, parameter, positions, np.asarray(group["time"][:], float),
+                                   np.asarray(group[quantity][:], float),
+                                   np.asarray(group["exact_" + quantity][:], float)))
+    return lines
+
+
+def read_point_history(path):
+    """The first probe point's history (time after every step), or None."""
+    with h5py.File(path, "r") as f:
+        for name, group in f.get("probes", {}).items():
+            quantity = _plain(group.attrs.get("quantity", ""))
+            if name != "circle" and quantity in group and group[quantity].ndim == 1:
+                return PointHistory(name, quantity, np.asarray(group.attrs.get("reference_position", [])),
+                                    np.asarray(group["time"][:], float), np.asarray(group[quantity][:], float),
+                                    np.asarray(group["exact_" + quantity][:], float))
+    return None
+
+
+def read_error_spectrum(path):
+    """/probes/circle/error_spectrum with its times, or None when absent or empty."""
+    with h5py.File(path, "r") as f:
+        circle = f.get("probes/circle")
+        if circle is None or "error_spectrum" not in circle or circle["error_spectrum"].shape[0] == 0:
+            return None
+        return ErrorSpectrum(_plain(circle.attrs.get("quantity", "")),
+                             float(circle.attrs.get("reference_radius", float("nan"))),
+                             np.asarray(circle["time"][:], float), np.asarray(circle["error_spectrum"][:], float))

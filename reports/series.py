@@ -1,0 +1,126 @@
+"""Refinement series: the cases of a study that differ only in the key that
+refines (suites/README.md, [[expect]]: "cases in which an expectation's refine
+key varies and all other keys agree form one refinement series").
+
+Rule, over a given set of cases (a study, or the cases an expectation's
+`where` selects), using each case's resolved keys from manifest.json:
+
+* a key *follows the refine key* when it varies among the cases but takes a
+  single value at each value of the refine key (it was zipped with it, or an
+  override sets it per level, e.g. a smaller cfl on the finest mesh);
+* cases that agree on every other key form one series; the keys that vary
+  between series name them (e.g. method=cpdi, amplitude=0.5);
+* a series' levels are sorted by cell size h (results attribute `h`), coarse
+  first; a case without results (pending, crashed, ...) has no h and takes its
+  place by its refine value, in the direction h takes in the other cases.
+"""
+import json
+import math
+from dataclasses import dataclass
+
+from results import lookup_error
+
+DEFAULT_REFINE_KEY = "cells"
+
+
+@dataclass(frozen=True)
+class Series:
+    study: str
+    refine: str
+    label_keys: dict      # the keys (and values) that tell this series from the others
+    cases: tuple          # coarse first
+
+    @property
+    def label(self):
+        """The keys that tell the series apart; for a lone series, its method when it has one."""
+        keys = self.label_keys
+        if not keys and self.cases and "method" in self.cases[0].keys:
+            keys = {"method": self.cases[0].keys["method"]}
+        return ", ".join(f"{key}={value}" for key, value in keys.items()) or "all cases"
+
+
+@dataclass(frozen=True)
+class Level:
+    case: object          # results.Case, or None for a requested level no case has
+    value: object         # the refine key's value
+    h: float
+    error: float          # NaN when the level is not usable
+    reason: str           # why the level is not usable; "" when it is
+
+
+def matches(keys, where):
+    """True when every key of `where` is among `keys` with an equal value."""
+    return all(name in keys and keys[name] == value for name, value in where.items())
+
+
+def _canonical(value):
+    """A hashable text for a key's value; 1 and 1.0 are the same value (a TOML echo may write either)."""
+    return json.dumps(_as_float(value), sort_keys=True)
+
+
+def _as_float(value):
+    if isinstance(value, bool):
+        return value
+    if isinstance(value, (int, float)):
+        return float(value)
+    if isinstance(value, list):
+        return [_as_float(v) for v in value]
+    if isinstance(value, dict):
+        return {k: _as_float(v) for k, v in value.items()}
+    return value
+
+
+def refinement_series(cases, refine=DEFAULT_REFINE_KEY):
+    """Split cases (of one study) into refinement series by the rule of the module docstring.
+    Cases without the refine key are left out."""
+    cases = [c for c in cases if refine in c.keys]
+    if not cases:
+        return []
+    names = list(dict.fromkeys(name for c in cases for name in c.keys if name != refine))
+    varying = [n for n in names if len({_canonical(c.keys.get(n)) for c in cases}) > 1]
+    grouping = [n for n in varying if not _follows(cases, n, refine)]
+    groups = {}
+    for case in cases:
+        groups.setdefault(tuple(_canonical(case.keys.get(n)) for n in grouping), []).append(case)
+    return [Series(study=members[0].study, refine=refine,
+                   label_keys={n: members[0].keys.get(n) for n in grouping},
+                   cases=tuple(_coarse_first(members, refine)))
+            for members in groups.values()]
+
+
+def _follows(cases, name, refine):
+    refine_values = {_canonical(c.keys[refine]) for c in cases}
+    if len(refine_values) < 2:
+        return False
+    return all(len({_canonical(c.keys.get(name)) for c in cases if _canonical(c.keys[refine]) == r}) == 1
+               for r in refine_values)
+
+
+def _coarse_first(cases, refine):
+    known = sorted((c for c in cases if math.isfinite(c.h)), key=lambda c: -c.h)
+    numeric = all(isinstance(c.keys[refine], (int, float)) for c in cases)
+    if len(known) == len(cases) or not numeric:
+        return known + [c for c in cases if not math.isfinite(c.h)]
+    h_falls_as_value_grows = len(known) < 2 or known[0].keys[refine] <= known[-1].keys[refine]
+    return sorted(cases, key=lambda c: c.keys[refine] if h_falls_as_value_grows else -c.keys[refine])
+
+
+def series_levels(series, norm, time=None, levels=None):
+    """One Level per case of the series (restricted to the refine values `levels`
+    when given, with a placeholder for a requested value no case has): its error
+    `norm` at output time `time` (default: the case's end time), or why not."""
+    chosen = list(series.cases)
+    result = []
+    if levels is not None:
+        chosen = [c for c in chosen if c.keys[series.refine] in levels]
+        present = [c.keys[series.refine] for c in chosen]
+        result = [Level(None, v, float("nan"), float("nan"), f"no case with {series.refine}={v}")
+                  for v in levels if v not in present]
+    for case in chosen:
+        error, reason = lookup_error(case, norm, case.end_time if time is None else time)
+        result.append(Level(case, case.keys[series.refine], case.h, error, reason))
+    return result
+
+
+def usable(levels):
+    return [level for level in levels if not level.reason]

@@ -1,0 +1,155 @@
+"""Requirements of the gate (reports/gate.py) and of refinement series
+(reports/series.py) on synthetic suite directories written with the layout of
+suites/README.md: every expectation is checked per series, a series holds only
+when its fitted order is in band, its error constant is under the limit and
+(must_complete) every case completed; exit 0 when all hold, 1 when one falls
+short, 2 with one line for a directory that cannot be read."""
+import json
+from dataclasses import replace
+
+import gate
+from conftest import SYNTHETIC_SUITE, synthetic_ring_cases, write_suite_directory
+from results import read_suite
+from series import refinement_series
+
+
+def run_gate(directory, capsys):
+    status = gate.main([str(directory)])
+    captured = capsys.readouterr()
+    return status, captured.out, captured.err
+
+
+def rows_of(output):
+    return [line for line in output.splitlines() if "PASS" in line or "FAIL" in line]
+
+
+def test_series_are_split_by_every_key_but_the_refine_key(synthetic_suite):
+    """Requirement: cases that agree on every key except `cells` form one series."""
+    series = refinement_series(read_suite(synthetic_suite).cases_of("ring"))
+    assert [s.label for s in series] == ["method=linear", "method=cpdi"]
+    assert [[c.keys["cells"] for c in s.cases] for s in series] == [[32, 64, 128, 256]] * 2
+
+
+def test_a_key_that_follows_the_refine_key_does_not_split_a_series(synthetic_suite):
+    """Requirement: a key set per level (an override cfl = 0.25 at 256 cells) or
+    written 1 vs 1.0 stays inside the series."""
+    cases = read_suite(synthetic_suite).cases_of("ring")
+    changed = [replace(c, keys={**c.keys, "cfl": 0.25 if c.keys["cells"] == 256 else 0.3,
+                                "end_time": 1 if c.keys["method"] == "cpdi" else 1.0}) for c in cases]
+    assert [s.label for s in refinement_series(changed)] == ["method=linear", "method=cpdi"]
+
+
+def test_series_levels_are_sorted_coarse_first_even_without_results(synthetic_suite):
+    """Requirement: a case without results (pending) takes its place by its refine value."""
+    cpdi = refinement_series(read_suite(synthetic_suite).cases_of("ring"))[1]
+    assert [c.keys["cells"] for c in cpdi.cases] == [32, 64, 128, 256]
+    assert cpdi.cases[-1].status == "pending"
+
+
+def test_gate_passes_on_an_exact_second_order_series(synthetic_suite, capsys):
+    """Requirement: E = 0.5 h^2 on 32, 64, 128 cells holds order 2 +- 0.1 and
+    E/h^2 <= 0.6; exit 0 and 'all N expectations hold'."""
+    status, out, _ = run_gate(synthetic_suite, capsys)
+    assert status == 0
+    [row] = rows_of(out)
+    assert "PASS" in row and "2.000 [2.00, 2.00]" in row and "[1.9, 2.1]" in row and "0.5 <= 0.6" in row
+    assert "all 1 expectations hold" in out
+
+
+MORE_EXPECTATIONS = """
+[[expect]]
+study = "ring"
+where = { method = "linear" }
+norm = "particle_L2"
+time = 0.25
+order = 1.0
+tolerance = 0.2
+
+[[expect]]
+study = "ring"
+norm = "L1_theta0"
+levels = [32, 64, 128]
+order = 2.0
+tolerance = 0.5
+must_complete = false
+
+[[expect]]
+study = "ring"
+where = { method = "cpdi" }
+norm = "L1_theta0"
+levels = [32, 64]
+order = 2.0
+tolerance = 0.5
+max_error_constant = 0.1
+"""
+
+
+def test_gate_fails_on_an_incomplete_series_and_out_of_band_orders(tmp_path, capsys):
+    """Requirement: a failed case fails a must_complete expectation with exit 1;
+    an order outside its band fails; an error constant above the limit fails;
+    a series with fewer than two usable levels fails with that reason; the
+    table shows observed against expected with the band."""
+    directory = write_suite_directory(tmp_path / "suite", SYNTHETIC_SUITE + MORE_EXPECTATIONS, synthetic_ring_cases())
+    status, out, _ = run_gate(directory, capsys)
+    assert status == 1
+    rows = rows_of(out)
+    assert len(rows) == 1 + 1 + 2 + 1
+    expect_2 = next(r for r in rows if r.startswith("2 "))
+    assert "FAIL" in expect_2 and "not completed" in expect_2
+    assert "cells=64 failed at t = 0.3 (non-positive J)" in expect_2
+    assert "cells=128 crashed" in expect_2
+    assert "1.000" in expect_2 and "[0.8, 1.2]" in expect_2      # fitted on 32, 64, 256: each wrote t = 0.25
+    linear_3, cpdi_3 = [r for r in rows if r.startswith("3 ")]
+    assert "FAIL" in linear_3 and "1 usable level(s), need 2" in linear_3 and "outside" not in linear_3
+    assert "PASS" in cpdi_3
+    expect_4 = next(r for r in rows if r.startswith("4 "))
+    assert "FAIL" in expect_4 and "E/h^2 = 0.5 > 0.1" in expect_4
+    assert "3 of 4 expectations fell short (3 of 5 series)" in out
+
+
+def test_gate_fails_on_an_order_outside_the_band(tmp_path, capsys):
+    """Requirement: E = 0.2 h (order 1) against an expected order 2 +- 0.3 fails."""
+    suite = SYNTHETIC_SUITE.replace('where = { method = "cpdi" }', 'where = { method = "linear" }')
+    suite = suite.replace("levels = [32, 64, 128]", "levels = [32, 256]")
+    directory = write_suite_directory(tmp_path / "suite", suite, synthetic_ring_cases())
+    status, out, _ = run_gate(directory, capsys)
+    [row] = rows_of(out)
+    assert status == 1 and "FAIL" in row and "order 1.000 outside [1.9, 2.1]" in row
+
+
+def test_gate_exit_2_with_one_line_for_a_bad_directory(tmp_path, capsys):
+    """Requirement: a missing directory, a missing or broken manifest, a missing
+    suite.toml and a malformed [[expect]] give exit 2 and one line naming it."""
+    status, out, err = run_gate(tmp_path / "nowhere", capsys)
+    assert status == 2 and err.count("\n") == 1 and "no such directory" in err
+    directory = write_suite_directory(tmp_path / "suite", SYNTHETIC_SUITE, synthetic_ring_cases())
+    (directory / "manifest.json").write_text("{not json")
+    status, out, err = run_gate(directory, capsys)
+    assert status == 2 and err.count("\n") == 1 and "manifest.json: not valid JSON" in err
+    directory = write_suite_directory(tmp_path / "suite2", SYNTHETIC_SUITE, synthetic_ring_cases())
+    (directory / "suite.toml").unlink()
+    status, out, err = run_gate(directory, capsys)
+    assert status == 2 and "suite.toml: missing" in err
+    directory = write_suite_directory(tmp_path / "suite3", SYNTHETIC_SUITE.replace("tolerance", "tolerence"),
+                                      synthetic_ring_cases())
+    status, out, err = run_gate(directory, capsys)
+    assert status == 2 and err.count("\n") == 1 and "'tolerance' is required" in err
+
+
+def test_gate_reports_an_expectation_that_matches_no_case(tmp_path, capsys):
+    """Requirement: an expectation whose `where` selects nothing fails instead of passing vacuously."""
+    suite = SYNTHETIC_SUITE.replace('where = { method = "cpdi" }', 'where = { method = "gimp" }')
+    directory = write_suite_directory(tmp_path / "suite", suite, synthetic_ring_cases())
+    status, out, _ = run_gate(directory, capsys)
+    assert status == 1 and "no case of study 'ring' matches" in out
+
+
+def test_manifest_status_is_kept_for_cases_without_results(synthetic_suite):
+    """Requirement: pending and crashed cases are read without results and with their status."""
+    cases = {c.id: c for c in read_suite(synthetic_suite).cases}
+    assert cases["ring-method=cpdi-cells=256"].status == "pending"
+    assert cases["ring-method=cpdi-cells=256"].results is None
+    crashed = cases["ring-method=linear-cells=128"]
+    assert crashed.status == "crashed" and crashed.failure_reason == "signal 11 (SIGSEGV)"
+    manifest = json.loads((synthetic_suite / "manifest.json").read_text())
+    assert len(manifest["cases"]) == len(cases)

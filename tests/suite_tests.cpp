@@ -1,0 +1,212 @@
+// Suites: the file is read and checked before anything runs; the runner keeps
+// every case in a process of its own, resumes, shares cases over MPI ranks;
+// the gate catches real faults. These tests run whole suites through the
+// built `mpmvv`, so ctest runs them one at a time.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+
+#include "tools/app/config.hpp"
+#include "tools/app/suite.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using mpmvv::app::ConfigError;
+
+const std::string kScenes = std::string(MPMVV_SOURCE_DIR) + "/suites/scenes";
+
+fs::path scratch(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("mpmvv-suite-tests-" + std::to_string(::getpid())) / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+fs::path write(const fs::path& path, const std::string& text) {
+  std::ofstream(path) << text;
+  return path;
+}
+
+std::string read(const fs::path& path) {
+  std::ifstream in(path);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+int shell(const std::string& command) {
+  const int status = std::system((command + " > /dev/null 2>&1").c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+int count(const std::string& text, const std::string& what) {
+  int n = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+std::string config_error(const fs::path& suite) {
+  try {
+    mpmvv::app::load_suite(suite.string());
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+// Three quick cases of the axis-aligned problem.
+std::string small_suite(double timeout = 120) {
+  return "timeout = " + std::to_string(timeout) + "\n[[study]]\nname = \"square\"\nscene = \"" + kScenes +
+         "/axis-aligned.toml\"\nset = { end_time = 0.005, output_times = [0.005] }\nsweep = { cells = [8, 12, 16] }\n";
+}
+
+}  // namespace
+
+// Sweep lists form a product (the last key fastest), zipped lists go together,
+// overrides reach the cases they match, and ids name the swept values in file
+// order.
+TEST(SuiteFile, ExpandsSweepZipAndOverrides) {
+  const fs::path dir = scratch("expand");
+  const fs::path suite = write(dir / "s.toml", "[[study]]\nname = \"r\"\nscene = \"" + kScenes + "/ring.toml\"\n"
+                                               "set = { end_time = 0.25 }\n"
+                                               "sweep = { method = [\"gimp\", \"cpdi\"], cells = [32, 64] }\n"
+                                               "zip = { particles_per_direction = [2, 3], cfl = [0.3, 0.2] }\n"
+                                               "[[study.override]]\nwhere = { cells = 64, method = \"cpdi\" }\n"
+                                               "set = { probe_points = 11 }\n");
+  const mpmvv::app::Suite s = mpmvv::app::load_suite(suite.string());
+  ASSERT_EQ(s.cases.size(), 8u);
+  EXPECT_EQ(s.cases[0].id, "r-method=gimp-cells=32-particles_per_direction=2-cfl=0.3");
+  EXPECT_EQ(s.cases[1].id, "r-method=gimp-cells=32-particles_per_direction=3-cfl=0.2");
+  EXPECT_EQ(s.cases[2].id, "r-method=gimp-cells=64-particles_per_direction=2-cfl=0.3");
+  EXPECT_EQ(s.cases[7].id, "r-method=cpdi-cells=64-particles_per_direction=3-cfl=0.2");
+  int overridden = 0;
+  for (const auto& c : s.cases) {
+    const bool match = c.keys.at("cells") == "64" && c.keys.at("method") == "\"cpdi\"";
+    overridden += match;
+    EXPECT_EQ(c.keys.at("probe_points"), match ? "11" : "51") << c.id;
+    EXPECT_NE(c.configuration.find("end_time = 0.25"), std::string::npos) << c.id;
+  }
+  EXPECT_EQ(overridden, 2);
+}
+
+// Every mistake is one message naming the file, the line and the key, before
+// anything runs.
+TEST(SuiteFile, MistakesNameFileLineAndKey) {
+  const fs::path dir = scratch("mistakes");
+  const std::string study = "[[study]]\nname = \"a\"\nscene = \"" + kScenes + "/ring.toml\"\n";
+  struct Case {
+    std::string text, mentions;
+  };
+  const Case cases[] = {
+      {study + "sweep = { cells = [32, 64], nokey = [1] }\n", "s.toml:4: sweep: unknown key 'nokey'"},
+      {study + "sweep = { cells = [32, 2] }\n", "s.toml:4: key 'cells' must be an integer in [4, 20000], got 2"},
+      {study + "set = { density = -1 }\n", "s.toml:4: key 'density' must be a number > 0"},
+      {study + "zip = { cells = [32, 64], cfl = [0.3] }\n", "zipped lists must be equally long"},
+      {study + "foo = 1\n", "s.toml:4: unknown key 'foo' in [[study]]"},
+      {study + "set = { cells = 32 }\nsweep = { cells = [32, 64] }\n", "key 'cells' is given twice"},
+      {study + "sweep = { cells = [32, 32] }\n", "'cells' lists 32 twice"},
+      {"[[study]]\nname = \"a\"\nscene = \"nope.toml\"\n", "s.toml:3: study 'a': no such scene file"},
+      {study + "[[expect]]\nstudy = \"b\"\nnorm = \"L1\"\norder = 2\ntolerance = 0.1\n", "s.toml:5: [[expect]]: no study named 'b'"},
+      {study + "sweep = { cells = [32, 64] }\n[[expect]]\nstudy = \"a\"\nnorm = \"L1_theta0\"\norder = 2\n",
+       "[[expect]] needs 'tolerance'"},
+      {study + "sweep = { cells = [32, 64] }\n[[expect]]\nstudy = \"a\"\nnorm = \"L1_theta0\"\norder = 2\ntolerance = 0.1\n"
+               "levels = [32, 128]\n",
+       "study 'a' has no case with cells = 128"},
+      {study + "set = { inner_radius = 1.3 }\n", "key 'outer_radius': must exceed inner_radius = 1.3 (from"},
+      {"[[study]]\nname = \"a b\"\n", "may hold only letters, digits"},
+      {"[[study]\n", "TOML syntax error"},
+  };
+  for (const Case& c : cases) {
+    const std::string message = config_error(write(dir / "s.toml", c.text));
+    EXPECT_NE(message.find(c.mentions), std::string::npos) << "message: " << message << "\nexpected: " << c.mentions;
+  }
+}
+
+// A case that crashes or hangs fails alone: the others complete, the manifest
+// says which ended how, no half-written results file remains, exit status 1.
+TEST(SuiteRunner, CrashAndHangAreIsolated) {
+  const fs::path dir = scratch("isolation");
+  const fs::path suite = write(dir / "s.toml", small_suite(3));
+  const int status = shell("MPMVV_FAULT=crash MPMVV_FAULT_ONLY=cells=12 " + std::string(MPMVV_BINARY) + " suite " +
+                           suite.string() + " -j 2 -q -o " + (dir / "out").string());
+  EXPECT_EQ(status, 1);
+  const std::string manifest = read(dir / "out" / "manifest.json");
+  EXPECT_EQ(count(manifest, "\"status\": \"completed\""), 2) << manifest;
+  EXPECT_EQ(count(manifest, "\"status\": \"crashed\""), 1) << manifest;
+  EXPECT_TRUE(fs::exists(dir / "out/cases/square-cells=8.h5"));
+  EXPECT_FALSE(fs::exists(dir / "out/cases/square-cells=12.h5"));
+
+  const int hung = shell("MPMVV_FAULT=hang MPMVV_FAULT_ONLY=cells=16 " + std::string(MPMVV_BINARY) + " suite " +
+                         suite.string() + " -j 2 -q -o " + (dir / "hang").string());
+  EXPECT_EQ(hung, 1);
+  const std::string hang_manifest = read(dir / "hang" / "manifest.json");
+  EXPECT_EQ(count(hang_manifest, "\"status\": \"timeout\""), 1) << hang_manifest;
+  EXPECT_EQ(count(hang_manifest, "\"status\": \"completed\""), 2) << hang_manifest;
+  for (const auto& entry : fs::recursive_directory_iterator(dir))
+    EXPECT_EQ(entry.path().string().find(".partial"), std::string::npos) << entry.path();
+}
+
+// A rerun keeps every case whose results file holds the same configuration
+// and runs only what is missing or changed.
+TEST(SuiteRunner, ResumeRunsOnlyWhatIsMissing) {
+  const fs::path dir = scratch("resume");
+  const fs::path suite = write(dir / "s.toml", small_suite());
+  const std::string run = std::string(MPMVV_BINARY) + " suite " + suite.string() + " -j 2 -q -o " + (dir / "out").string();
+  ASSERT_EQ(shell(run), 0);
+  const fs::path kept = dir / "out/cases/square-cells=8.h5";
+  const auto written = fs::last_write_time(kept);
+  fs::remove(dir / "out/cases/square-cells=16.h5");
+  ASSERT_EQ(shell(run), 0);
+  const std::string manifest = read(dir / "out" / "manifest.json");
+  EXPECT_EQ(count(manifest, "kept from an earlier run"), 2) << manifest;
+  EXPECT_EQ(count(manifest, "\"status\": \"completed\""), 3) << manifest;
+  EXPECT_EQ(fs::last_write_time(kept), written);
+  EXPECT_TRUE(fs::exists(dir / "out/cases/square-cells=16.h5"));
+  // A changed configuration is not kept.
+  write(suite, small_suite() + "[[study.override]]\nwhere = { cells = 8 }\nset = { cfl = 0.25 }\n");
+  ASSERT_EQ(shell(run), 0);
+  EXPECT_EQ(count(read(dir / "out" / "manifest.json"), "kept from an earlier run"), 2);
+}
+
+// Under mpirun the two ranks share the cases and one manifest lists them all.
+TEST(SuiteRunner, MpiRanksShareTheCases) {
+  if (shell("command -v mpirun") != 0) GTEST_SKIP() << "mpirun is not installed";
+  const fs::path dir = scratch("mpi");
+  const fs::path suite = write(dir / "s.toml", small_suite());
+  const int status = shell("mpirun --allow-run-as-root --oversubscribe -n 2 " + std::string(MPMVV_BINARY) + " suite " +
+                           suite.string() + " -q -o " + (dir / "out").string());
+  ASSERT_EQ(status, 0);
+  const std::string manifest = read(dir / "out" / "manifest.json");
+  EXPECT_EQ(count(manifest, "\"status\": \"completed\""), 3) << manifest;
+  EXPECT_TRUE(fs::exists(dir / "out" / "summary.txt"));
+}
+
+namespace {
+
+// Runs the CI gate's quick suite (with an injected fault, or none) and returns
+// the gate's exit status.
+int quick_suite_gate(const std::string& fault, const std::string& name) {
+  const fs::path dir = scratch(name);
+  const std::string environment = fault.empty() ? "" : "MPMVV_FAULT=" + fault + " ";
+  const std::string suite = std::string(MPMVV_SOURCE_DIR) + "/suites/ring-quick.toml";
+  const int ran = shell(environment + MPMVV_BINARY + " suite " + suite + " -j 2 -q -o " + (dir / "out").string());
+  EXPECT_EQ(ran, 0) << "the quick suite itself must run";
+  return shell(std::string(MPMVV_BINARY) + " gate " + (dir / "out").string());
+}
+
+}  // namespace
+
+// The gate passes on the quick suite and fails when the body force is left out
+// or the CPDI gradients carry a 4 % error: it catches real faults.
+TEST(Gate, QuickSuitePasses) { EXPECT_EQ(quick_suite_gate("", "gate-healthy"), 0); }
+TEST(Gate, FailsWithoutTheBodyForce) { EXPECT_EQ(quick_suite_gate("no-body-force", "gate-no-force"), 1); }
+TEST(Gate, FailsWithPerturbedCpdiGradients) { EXPECT_EQ(quick_suite_gate("cpdi-gradient", "gate-gradient"), 1); }

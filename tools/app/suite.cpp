@@ -1,0 +1,817 @@
+#include "suite.hpp"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <regex>
+#include <sstream>
+#include <thread>
+
+#include <fmt/format.h>
+#include <fmt/ostream.h>
+#include <toml++/toml.h>
+
+#ifdef MPMVV_HAVE_MPI
+// The C API only; OpenMPI's header would pull in its deprecated C++ bindings.
+#define OMPI_SKIP_MPICXX 1
+#define MPICH_SKIP_MPICXX 1
+#include <mpi.h>
+#endif
+
+#include "config.hpp"
+#include "scene.hpp"
+#include "solver/io/hdf5.hpp"
+
+extern char** environ;
+
+namespace mpmvv::app {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// ------------------------------------------------------------------ reading the suite
+
+std::string where_in(const std::string& file, const toml::node& n) {
+  return fmt::format("{}:{}", file, n.source().begin.line);
+}
+
+// A TOML value as a configuration value, or nothing for a type no key takes.
+std::optional<Value> to_value(const toml::node& n) {
+  if (n.is_integer()) return Value(n.as_integer()->get());
+  if (n.is_floating_point()) return Value(n.as_floating_point()->get());
+  if (n.is_string()) return Value(n.as_string()->get());
+  if (n.is_array()) {
+    std::vector<double> list;
+    for (const toml::node& item : *n.as_array()) {
+      if (item.is_integer()) list.push_back(double(item.as_integer()->get()));
+      else if (item.is_floating_point()) list.push_back(item.as_floating_point()->get());
+      else return std::nullopt;
+    }
+    return Value(list);
+  }
+  return std::nullopt;
+}
+
+// The value as `mpmvv run --set` reads it.
+std::string as_setting(const Value& v) {
+  if (const auto* s = std::get_if<std::string>(&v)) return *s;
+  return format_value(v);
+}
+
+bool same_value(const Value& a, const Value& b) {
+  auto number = [](const Value& v) -> std::optional<double> {
+    if (const auto* i = std::get_if<std::int64_t>(&v)) return double(*i);
+    if (const auto* d = std::get_if<double>(&v)) return *d;
+    return std::nullopt;
+  };
+  if (number(a) && number(b)) return *number(a) == *number(b);
+  return a == b;
+}
+
+// The entries of a table in the order the file gives them (toml++ keeps keys sorted).
+std::vector<std::pair<std::string, const toml::node*>> in_file_order(const toml::table& table) {
+  std::vector<std::pair<std::string, const toml::node*>> entries;
+  for (const auto& [k, node] : table) entries.emplace_back(std::string(k.str()), &node);
+  std::stable_sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) {
+    const auto& pa = a.second->source().begin;
+    const auto& pb = b.second->source().begin;
+    return pa.line != pb.line ? pa.line < pb.line : pa.column < pb.column;
+  });
+  return entries;
+}
+
+void expect_only(const toml::table& table, std::initializer_list<const char*> allowed, const std::string& file,
+                 const std::string& what) {
+  for (const auto& [k, node] : table) {
+    bool known = false;
+    for (const char* a : allowed) known = known || k.str() == a;
+    if (!known) {
+      std::string list;
+      for (const char* a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
+      throw ConfigError(fmt::format("{}: unknown key '{}' in {} (known: {})", where_in(file, node), k.str(), what, list));
+    }
+  }
+}
+
+const toml::table& table_at(const toml::node& n, const std::string& file, const std::string& what) {
+  if (!n.is_table()) throw ConfigError(fmt::format("{}: '{}' must be a table", where_in(file, n), what));
+  return *n.as_table();
+}
+
+struct Setting {
+  std::string key;
+  Value value;
+  std::string origin;  // file:line
+};
+
+// key = value pairs of a table, each checked to name a key of the scene.
+std::vector<Setting> settings_of(const toml::table& table, const std::string& file, const std::vector<KeySpec>& specs,
+                                 const std::string& scene, const std::string& what) {
+  std::vector<Setting> out;
+  for (const auto& [key, node_pointer] : in_file_order(table)) {
+    const toml::node& node = *node_pointer;
+    const bool known = std::any_of(specs.begin(), specs.end(), [&](const KeySpec& s) { return s.name == key; });
+    if (!known)
+      throw ConfigError(fmt::format("{}: {}: unknown key '{}' for scene '{}' (mpmvv scenes lists them)",
+                                    where_in(file, node), what, key, scene));
+    const std::optional<Value> v = to_value(node);
+    if (!v) throw ConfigError(fmt::format("{}: {}: key '{}' has a value of an unsupported type", where_in(file, node), what, key));
+    out.push_back({key, *v, where_in(file, node)});
+  }
+  return out;
+}
+
+// Lists of a sweep or zip table: key -> values, each value with its origin.
+struct Axis {
+  std::string key;
+  std::vector<Value> values;
+  std::string origin;
+};
+
+std::vector<Axis> axes_of(const toml::table& table, const std::string& file, const std::vector<KeySpec>& specs,
+                          const std::string& scene, const std::string& what) {
+  std::vector<Axis> axes;
+  for (const auto& [key, node_pointer] : in_file_order(table)) {
+    const toml::node& node = *node_pointer;
+    const bool known = std::any_of(specs.begin(), specs.end(), [&](const KeySpec& s) { return s.name == key; });
+    if (!known)
+      throw ConfigError(fmt::format("{}: {}: unknown key '{}' for scene '{}'", where_in(file, node), what, key, scene));
+    if (!node.is_array() || node.as_array()->empty())
+      throw ConfigError(fmt::format("{}: {}: '{}' must be a non-empty list of values", where_in(file, node), what, key));
+    Axis axis{key, {}, where_in(file, node)};
+    for (const toml::node& item : *node.as_array()) {
+      const std::optional<Value> v = to_value(item);
+      if (!v) throw ConfigError(fmt::format("{}: {}: '{}' holds a value of an unsupported type", where_in(file, node), what, key));
+      for (const Value& seen : axis.values)
+        if (same_value(seen, *v))
+          throw ConfigError(fmt::format("{}: {}: '{}' lists {} twice", where_in(file, node), what, key, format_value(*v)));
+      axis.values.push_back(*v);
+    }
+    axes.push_back(std::move(axis));
+  }
+  return axes;
+}
+
+std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (const char c : s) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\t': out += "\\t"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) out += fmt::format("\\u{:04x}", int(c));
+        else out += c;
+    }
+  }
+  return out + "\"";
+}
+
+std::string json_value(const Value& v) {
+  if (const auto* s = std::get_if<std::string>(&v)) return json_string(*s);
+  return format_value(v);  // numbers and lists of numbers are already JSON
+}
+
+std::string id_part(const Value& v) {
+  std::string s = as_setting(v);
+  std::replace(s.begin(), s.end(), ' ', '_');
+  std::replace(s.begin(), s.end(), '/', '_');
+  return s;
+}
+
+}  // namespace
+
+Suite load_suite(const std::string& path) {
+  if (!fs::exists(path)) throw ConfigError(fmt::format("{}: no such suite file", path));
+  toml::table top;
+  try {
+    top = toml::parse_file(path);
+  } catch (const toml::parse_error& e) {
+    throw ConfigError(fmt::format("{}:{}:{}: TOML syntax error: {}", path, e.source().begin.line,
+                                  e.source().begin.column, e.description()));
+  }
+  expect_only(top, {"description", "timeout", "study", "expect"}, path, "the suite");
+  Suite suite;
+  suite.file = path;
+  suite.name = fs::path(path).stem().string();
+  if (const toml::node* d = top.get("description")) {
+    if (!d->is_string()) throw ConfigError(fmt::format("{}: 'description' must be a string", where_in(path, *d)));
+    suite.description = d->as_string()->get();
+  }
+  if (const toml::node* t = top.get("timeout")) {
+    const std::optional<Value> v = to_value(*t);
+    const double seconds = v && std::holds_alternative<std::int64_t>(*v) ? double(std::get<std::int64_t>(*v))
+                           : v && std::holds_alternative<double>(*v)     ? std::get<double>(*v)
+                                                                         : -1.0;
+    if (!(seconds > 0.0)) throw ConfigError(fmt::format("{}: 'timeout' must be a positive number of seconds", where_in(path, *t)));
+    suite.timeout_seconds = seconds;
+  }
+  const toml::node* studies = top.get("study");
+  if (!studies || !studies->is_array_of_tables() || studies->as_array()->empty())
+    throw ConfigError(fmt::format("{}: a suite needs at least one [[study]]", path));
+
+  const fs::path base = fs::path(path).parent_path();
+  const std::regex name_pattern("[A-Za-z0-9_-]+");
+  std::map<std::string, std::vector<KeySpec>> study_keys;
+  std::map<std::string, std::vector<const SuiteCase*>> study_cases;
+
+  for (const toml::node& node : *studies->as_array()) {
+    const toml::table& study = *node.as_table();
+    const std::string here = where_in(path, node);
+    expect_only(study, {"name", "scene", "set", "sweep", "zip", "override"}, path, "[[study]]");
+    const toml::node* name_node = study.get("name");
+    if (!name_node || !name_node->is_string())
+      throw ConfigError(fmt::format("{}: [[study]] needs a name (a string)", here));
+    const std::string name = name_node->as_string()->get();
+    if (!std::regex_match(name, name_pattern))
+      throw ConfigError(fmt::format("{}: study name '{}' may hold only letters, digits, '-' and '_'", where_in(path, *name_node), name));
+    if (study_keys.count(name)) throw ConfigError(fmt::format("{}: a second study named '{}'", where_in(path, *name_node), name));
+    const toml::node* scene_node = study.get("scene");
+    if (!scene_node || !scene_node->is_string())
+      throw ConfigError(fmt::format("{}: study '{}' needs a scene (a scene file, relative to the suite)", here, name));
+    const std::string scene_file = (base / scene_node->as_string()->get()).lexically_normal().string();
+    if (!fs::exists(scene_file))
+      throw ConfigError(fmt::format("{}: study '{}': no such scene file {}", where_in(path, *scene_node), name, scene_file));
+
+    // The scene's own file decides the scene type and its keys.
+    Config scene_config("", {});
+    try {
+      scene_config = load_scene_file(
+          scene_file,
+          [](const std::string& n) -> std::optional<std::vector<KeySpec>> {
+            const SceneType* t = find_scene_type(n);
+            if (!t) return std::nullopt;
+            return t->keys();
+          },
+          {});
+    } catch (const ConfigError& e) {
+      throw ConfigError(fmt::format("{}: study '{}': {}", where_in(path, *scene_node), name, e.what()));
+    }
+    const std::vector<KeySpec> specs = scene_config.specs();
+    study_keys[name] = specs;
+
+    std::vector<Setting> fixed;
+    if (const toml::node* s = study.get("set")) fixed = settings_of(table_at(*s, path, "set"), path, specs, scene_config.scene(), "set");
+    std::vector<Axis> sweep, zip;
+    if (const toml::node* s = study.get("sweep")) sweep = axes_of(table_at(*s, path, "sweep"), path, specs, scene_config.scene(), "sweep");
+    if (const toml::node* s = study.get("zip")) zip = axes_of(table_at(*s, path, "zip"), path, specs, scene_config.scene(), "zip");
+    std::size_t zip_length = zip.empty() ? 1 : zip.front().values.size();
+    for (const Axis& a : zip)
+      if (a.values.size() != zip_length)
+        throw ConfigError(fmt::format("{}: zip: '{}' has {} values but '{}' has {}: zipped lists must be equally long",
+                                      a.origin, a.key, a.values.size(), zip.front().key, zip_length));
+    // A key belongs to one of set, sweep, zip.
+    std::vector<std::string> seen;
+    auto claim = [&](const std::string& key, const std::string& origin) {
+      if (std::find(seen.begin(), seen.end(), key) != seen.end())
+        throw ConfigError(fmt::format("{}: study '{}': key '{}' is given twice (in set, sweep or zip)", origin, name, key));
+      seen.push_back(key);
+    };
+    for (const Setting& s : fixed) claim(s.key, s.origin);
+    for (const Axis& a : sweep) claim(a.key, a.origin);
+    for (const Axis& a : zip) claim(a.key, a.origin);
+
+    struct Override {
+      std::vector<Setting> where, set;
+    };
+    std::vector<Override> overrides;
+    if (const toml::node* o = study.get("override")) {
+      if (!o->is_array_of_tables()) throw ConfigError(fmt::format("{}: 'override' must be [[study.override]] tables", where_in(path, *o)));
+      for (const toml::node& item : *o->as_array()) {
+        const toml::table& t = *item.as_table();
+        expect_only(t, {"where", "set"}, path, "[[study.override]]");
+        Override ov;
+        if (const toml::node* w = t.get("where")) ov.where = settings_of(table_at(*w, path, "where"), path, specs, scene_config.scene(), "override where");
+        if (const toml::node* s = t.get("set")) ov.set = settings_of(table_at(*s, path, "set"), path, specs, scene_config.scene(), "override set");
+        if (ov.set.empty()) throw ConfigError(fmt::format("{}: [[study.override]] needs a 'set' table", where_in(path, item)));
+        overrides.push_back(std::move(ov));
+      }
+    }
+
+    // The product of the sweep lists, times the zipped tuples.
+    std::vector<std::size_t> counter(sweep.size(), 0);
+    for (bool more = true; more;) {
+      for (std::size_t z = 0; z < zip_length; ++z) {
+        Config config = scene_config;
+        SuiteCase c;
+        c.study = name;
+        c.scene_file = scene_file;
+        c.id = name;
+        auto apply = [&](const std::string& key, const Value& v, const std::string& origin) {
+          config.set(key, v, Origin{origin});
+          c.overrides.push_back(key + "=" + as_setting(v));
+        };
+        for (const Setting& s : fixed) apply(s.key, s.value, s.origin);
+        for (std::size_t a = 0; a < sweep.size(); ++a) {
+          const Value& v = sweep[a].values[counter[a]];
+          apply(sweep[a].key, v, sweep[a].origin);
+          c.id += "-" + sweep[a].key + "=" + id_part(v);
+        }
+        for (const Axis& a : zip) {
+          apply(a.key, a.values[z], a.origin);
+          c.id += "-" + a.key + "=" + id_part(a.values[z]);
+        }
+        for (const Override& ov : overrides) {
+          const bool match = std::all_of(ov.where.begin(), ov.where.end(),
+                                         [&](const Setting& w) { return same_value(config.value(w.key), w.value); });
+          if (match)
+            for (const Setting& s : ov.set) apply(s.key, s.value, s.origin);
+        }
+        // The scene's own rules between keys, before anything runs.
+        find_scene_type(config.scene())->build(config);
+        c.configuration = config.to_toml();
+        for (const KeySpec& k : specs) c.keys[k.name] = json_value(config.value(k.name));
+        for (const SuiteCase& other : suite.cases)
+          if (other.id == c.id) throw ConfigError(fmt::format("{}: two cases have the id '{}'", here, c.id));
+        suite.cases.push_back(std::move(c));
+      }
+      // Next combination of the sweep lists, the last key fastest.
+      more = false;
+      for (std::size_t a = sweep.size(); a-- > 0;) {
+        if (++counter[a] < sweep[a].values.size()) {
+          more = true;
+          break;
+        }
+        counter[a] = 0;
+      }
+    }
+  }
+
+  // Expectations name a study, keys of its scene and levels it has.
+  if (const toml::node* expects = top.get("expect")) {
+    if (!expects->is_array_of_tables()) throw ConfigError(fmt::format("{}: 'expect' must be [[expect]] tables", where_in(path, *expects)));
+    for (const toml::node& node : *expects->as_array()) {
+      const toml::table& e = *node.as_table();
+      const std::string here = where_in(path, node);
+      expect_only(e, {"study", "where", "norm", "time", "refine", "levels", "order", "tolerance", "max_error_constant",
+                      "must_complete"},
+                  path, "[[expect]]");
+      const toml::node* study = e.get("study");
+      if (!study || !study->is_string()) throw ConfigError(fmt::format("{}: [[expect]] needs the study it checks", here));
+      const std::string name = study->as_string()->get();
+      if (!study_keys.count(name)) throw ConfigError(fmt::format("{}: [[expect]]: no study named '{}'", where_in(path, *study), name));
+      const std::vector<KeySpec>& specs = study_keys[name];
+      auto is_key = [&](const std::string& k) {
+        return std::any_of(specs.begin(), specs.end(), [&](const KeySpec& s) { return s.name == k; });
+      };
+      if (const toml::node* w = e.get("where")) settings_of(table_at(*w, path, "where"), path, specs, name, "[[expect]] where");
+      const toml::node* norm = e.get("norm");
+      if (!norm || !norm->is_string()) throw ConfigError(fmt::format("{}: [[expect]] needs a norm (an /errors column, e.g. \"L1_theta0\")", here));
+      for (const char* k : {"order", "tolerance"}) {
+        const toml::node* n = e.get(k);
+        if (!n || !(n->is_integer() || n->is_floating_point()))
+          throw ConfigError(fmt::format("{}: [[expect]] needs '{}' (a number)", here, k));
+      }
+      if (const toml::node* t = e.get("tolerance"); !(t->value<double>().value_or(-1.0) > 0.0))
+        throw ConfigError(fmt::format("{}: [[expect]]: 'tolerance' must be positive", where_in(path, *t)));
+      if (const toml::node* m = e.get("max_error_constant"); m && !(m->value<double>().value_or(-1.0) > 0.0))
+        throw ConfigError(fmt::format("{}: [[expect]]: 'max_error_constant' must be a positive number", where_in(path, *m)));
+      if (const toml::node* t = e.get("time"); t && !(t->value<double>().value_or(-1.0) >= 0.0))
+        throw ConfigError(fmt::format("{}: [[expect]]: 'time' must be a time >= 0", where_in(path, *t)));
+      if (const toml::node* m = e.get("must_complete"); m && !m->is_boolean())
+        throw ConfigError(fmt::format("{}: [[expect]]: 'must_complete' must be true or false", where_in(path, *m)));
+      std::string refine = "cells";
+      if (const toml::node* r = e.get("refine")) {
+        if (!r->is_string() || !is_key(r->as_string()->get()))
+          throw ConfigError(fmt::format("{}: [[expect]]: 'refine' must name a key of study '{}'", where_in(path, *r), name));
+        refine = r->as_string()->get();
+      }
+      if (const toml::node* l = e.get("levels")) {
+        const std::optional<Value> v = to_value(*l);
+        if (!v || !std::holds_alternative<std::vector<double>>(*v) || std::get<std::vector<double>>(*v).size() < 2)
+          throw ConfigError(fmt::format("{}: [[expect]]: 'levels' must list two or more values of '{}'", where_in(path, *l), refine));
+        for (double level : std::get<std::vector<double>>(*v)) {
+          const bool present = std::any_of(suite.cases.begin(), suite.cases.end(), [&](const SuiteCase& c) {
+            return c.study == name && c.keys.count(refine) && std::abs(std::stod(c.keys.at(refine)) - level) < 1e-12 * std::max(1.0, std::abs(level));
+          });
+          if (!present)
+            throw ConfigError(fmt::format("{}: [[expect]]: study '{}' has no case with {} = {}", where_in(path, *l), name, refine, level));
+        }
+      }
+    }
+  }
+  return suite;
+}
+
+// ------------------------------------------------------------------ running
+
+namespace {
+
+volatile sig_atomic_t interrupted = 0;
+void on_interrupt(int) { interrupted = 1; }
+
+struct CaseState {
+  std::string status = "pending";
+  int exit_code = -1;
+  double wall = 0.0;
+  std::string detail;
+};
+
+std::string case_json(const SuiteCase& c, const CaseState& s, const std::string& results) {
+  std::string keys;
+  for (const auto& [k, v] : c.keys) keys += (keys.empty() ? "" : ", ") + json_string(k) + ": " + v;
+  std::string overrides;
+  for (const std::string& o : c.overrides) overrides += (overrides.empty() ? "" : ", ") + json_string(o);
+  return fmt::format(
+      "{{\"id\": {}, \"study\": {}, \"scene\": {}, \"keys\": {{{}}}, \"overrides\": [{}], \"results\": {}, "
+      "\"status\": {}, \"exit_code\": {}, \"wall_time_s\": {}, \"detail\": {}}}",
+      json_string(c.id), json_string(c.study), json_string(c.scene_file), keys, overrides, json_string(results),
+      json_string(s.status), s.exit_code, fmt::format("{:.6g}", s.wall), json_string(s.detail));
+}
+
+void write_atomically(const fs::path& path, const std::string& text) {
+  const fs::path partial = path.string() + ".partial";
+  {
+    std::ofstream out(partial);
+    out << text;
+    if (!out) throw std::runtime_error("cannot write " + partial.string());
+  }
+  fs::rename(partial, path);
+}
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// The last non-empty line of a log: the one-line message of a refused run.
+std::string last_line(const fs::path& log) {
+  std::istringstream in(read_text(log));
+  std::string line, last;
+  while (std::getline(in, line))
+    if (!line.empty()) last = line;
+  return last;
+}
+
+// What a results file says of its run, or nothing when it is not a
+// finished results file of this configuration.
+std::optional<CaseState> finished_state(const fs::path& results, const std::string& configuration) {
+  if (!fs::exists(results)) return std::nullopt;
+  try {
+    const h5::File f = h5::File::open_read(results.string());
+    const h5::Group root = f.root();
+    if (root.attribute_string("configuration") != configuration) return std::nullopt;
+    CaseState s;
+    s.status = root.attribute_string("status");
+    s.exit_code = s.status == "completed" ? 0 : 1;
+    s.wall = root.attribute_double("wall_time_s");
+    if (s.status != "completed")
+      s.detail = fmt::format("{} at t = {:.4g} s", root.attribute_string("failure_reason"), root.attribute_double("failure_time"));
+    return s;
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
+std::string self_executable() {
+  std::error_code ec;
+  const fs::path p = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) throw std::runtime_error("cannot find the mpmvv executable (/proc/self/exe): " + ec.message());
+  return p.string();
+}
+
+struct Running {
+  std::size_t index;
+  pid_t pid;
+  std::chrono::steady_clock::time_point start;
+  bool timed_out = false;
+};
+
+// Starts `mpmvv run` for a case in a process group of its own, with its output
+// in the case's log.
+pid_t spawn_case(const std::string& exe, const SuiteCase& c, const fs::path& results, const fs::path& log, int threads,
+                 bool passive_wait) {
+  std::vector<std::string> args = {exe, "run", c.scene_file};
+  for (const std::string& o : c.overrides) {
+    args.push_back("--set");
+    args.push_back(o);
+  }
+  for (const std::string& a : {std::string("-o"), results.string(), std::string("--quiet"), std::string("--threads"),
+                               std::to_string(threads)})
+    args.push_back(a);
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+
+  std::vector<std::string> env_strings;
+  for (char** e = environ; *e; ++e)
+    if (std::string(*e).rfind("OMP_WAIT_POLICY=", 0) != 0) env_strings.emplace_back(*e);
+  // Cases share the cores: waiting threads must not spin on them.
+  if (passive_wait) env_strings.emplace_back("OMP_WAIT_POLICY=passive");
+  std::vector<char*> envp;
+  for (std::string& e : env_strings) envp.push_back(e.data());
+  envp.push_back(nullptr);
+
+  posix_spawn_file_actions_t actions;
+  posix_spawnattr_t attributes;
+  if (posix_spawn_file_actions_init(&actions) != 0 || posix_spawnattr_init(&attributes) != 0)
+    throw std::runtime_error("posix_spawn initialisation failed");
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETPGROUP);
+  posix_spawnattr_setpgroup(&attributes, 0);
+  pid_t pid = -1;
+  const int rc = posix_spawn(&pid, exe.c_str(), &actions, &attributes, argv.data(), envp.data());
+  posix_spawn_file_actions_destroy(&actions);
+  posix_spawnattr_destroy(&attributes);
+  if (rc != 0) throw std::runtime_error(fmt::format("posix_spawn {} failed: {}", exe, std::strerror(rc)));
+  return pid;
+}
+
+std::string duration(double seconds) {
+  if (!std::isfinite(seconds) || seconds < 0) return "?";
+  if (seconds < 60) return fmt::format("{:.0f}s", seconds);
+  if (seconds < 3600) return fmt::format("{}m{:02d}s", int(seconds) / 60, int(seconds) % 60);
+  return fmt::format("{}h{:02d}m", int(seconds) / 3600, (int(seconds) % 3600) / 60);
+}
+
+// The first error column at the last output time, for the summary.
+std::string headline_error(const fs::path& results) {
+  try {
+    const h5::File f = h5::File::open_read(results.string());
+    const h5::Group errors = f.root().open_group("errors");
+    for (const std::string& name : errors.members()) {
+      if (name == "time") continue;
+      const std::vector<double> v = errors.read_doubles(name);
+      if (v.empty()) return "";
+      return fmt::format("{} {:.3e}", name, v.back());
+    }
+  } catch (const std::exception&) {
+  }
+  return "";
+}
+
+}  // namespace
+
+int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err) {
+  int rank = 0, ranks = 1;
+#ifdef MPMVV_HAVE_MPI
+  // Under mpirun the ranks share out the cases; run alone, MPI stays out.
+  const bool under_mpi = std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMI_SIZE") || std::getenv("PMIX_RANK");
+  if (under_mpi) {
+    if (MPI_Init(nullptr, nullptr) != MPI_SUCCESS) {
+      fmt::print(err, "mpmvv suite: MPI_Init failed\n");
+      return 2;
+    }
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  }
+  auto finish_mpi = [&](int status) {
+    if (under_mpi) MPI_Finalize();
+    return status;
+  };
+#else
+  auto finish_mpi = [](int status) { return status; };
+#endif
+
+  Suite suite;
+  try {
+    suite = load_suite(request.suite_file);
+  } catch (const ConfigError& e) {
+    if (rank == 0) fmt::print(err, "mpmvv suite: {}\n", e.what());
+    return finish_mpi(2);
+  }
+  if (request.list) {
+    if (rank == 0) {
+      fmt::print(out, "suite {}: {} cases, timeout {} s{}\n", suite.file, suite.cases.size(), suite.timeout_seconds,
+                 suite.description.empty() ? "" : "\n" + suite.description);
+      for (const SuiteCase& c : suite.cases) {
+        std::string settings;
+        for (const std::string& o : c.overrides)
+          settings += o.find(' ') == std::string::npos ? " --set " + o : " --set '" + o + "'";
+        fmt::print(out, "{:<48} {}{}\n", c.id, c.scene_file, settings);
+      }
+    }
+    return finish_mpi(0);
+  }
+  const fs::path dir = request.output_dir.empty() ? fs::path("results") / suite.name : fs::path(request.output_dir);
+  const fs::path cases_dir = dir / "cases";
+  std::error_code ec;
+  fs::create_directories(cases_dir, ec);
+  if (ec) {
+    if (rank == 0) fmt::print(err, "mpmvv suite: -o {}: cannot create {}: {}\n", dir.string(), cases_dir.string(), ec.message());
+    return finish_mpi(2);
+  }
+  if (rank == 0) fs::copy_file(suite.file, dir / "suite.toml", fs::copy_options::overwrite_existing, ec);
+
+  const std::size_t n = suite.cases.size();
+  std::vector<CaseState> state(n);
+  auto results_of = [&](std::size_t i) { return cases_dir / (suite.cases[i].id + ".h5"); };
+  auto relative_results = [&](std::size_t i) { return "cases/" + suite.cases[i].id + ".h5"; };
+  auto record = [&](std::size_t i) {
+    write_atomically(cases_dir / (suite.cases[i].id + ".json"), case_json(suite.cases[i], state[i], relative_results(i)) + "\n");
+  };
+  auto write_manifest = [&]() {
+    std::string cases;
+    for (std::size_t i = 0; i < n; ++i) {
+      const fs::path status_file = cases_dir / (suite.cases[i].id + ".json");
+      std::string object;
+      if (fs::exists(status_file)) {
+        object = read_text(status_file);
+        while (!object.empty() && (object.back() == '\n' || object.back() == ' ')) object.pop_back();
+      } else {
+        object = case_json(suite.cases[i], CaseState{}, relative_results(i));
+      }
+      cases += (i ? ",\n  " : "\n  ") + object;
+    }
+    const std::time_t now = std::time(nullptr);
+    char stamp[32];
+    std::strftime(stamp, sizeof stamp, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+    write_atomically(dir / "manifest.json",
+                     fmt::format("{{\"suite\": {}, \"suite_file\": {}, \"description\": {}, \"written\": {}, "
+                                 "\"cases\": [{}\n]}}\n",
+                                 json_string(suite.name), json_string(suite.file), json_string(suite.description),
+                                 json_string(stamp), cases));
+  };
+
+  // This rank's share, and what an earlier run already finished.
+  std::vector<std::size_t> queue;
+  std::size_t resumed = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (i % std::size_t(ranks) != std::size_t(rank)) continue;
+    if (const auto done = finished_state(results_of(i), suite.cases[i].configuration)) {
+      state[i] = *done;
+      state[i].detail = (state[i].detail.empty() ? "" : state[i].detail + "; ") + "kept from an earlier run";
+      record(i);
+      ++resumed;
+    } else {
+      queue.push_back(i);
+    }
+  }
+
+  const int cores = std::max(1u, std::thread::hardware_concurrency());
+  const int jobs = std::max(1, request.jobs);
+  const int threads = std::max(1, cores / (jobs * ranks));
+  const bool passive = jobs * ranks > 1;
+  const std::string exe = self_executable();
+  const bool tty = isatty(fileno(stderr));
+  const std::string prefix = ranks > 1 ? fmt::format("[rank {}] ", rank) : "";
+  if (!request.quiet)
+    fmt::print(err, "{}mpmvv suite {}: {} cases ({} here, {} kept from an earlier run), {} at once, {} threads each -> {}\n",
+               prefix, suite.file, n, queue.size() + resumed, resumed, jobs, threads, dir.string());
+
+  struct sigaction action {};
+  action.sa_handler = on_interrupt;
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+
+  std::vector<Running> running;
+  std::size_t next = 0, finished = 0;
+  double finished_wall = 0.0;
+  const auto suite_start = std::chrono::steady_clock::now();
+  auto last_progress = suite_start - std::chrono::seconds(10);
+  auto progress = [&](bool force) {
+    if (request.quiet) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (!force && now - last_progress < std::chrono::milliseconds(tty ? 500 : 10000)) return;
+    last_progress = now;
+    std::size_t completed = 0, failed = 0, broken = 0;
+    for (std::size_t i : queue) {
+      if (state[i].status == "completed") ++completed;
+      else if (state[i].status == "failed") ++failed;
+      else if (state[i].status != "pending" && state[i].status != "running") ++broken;
+    }
+    const std::size_t remaining = queue.size() - finished;
+    const double eta = finished ? finished_wall / double(finished) * double(remaining) / double(jobs) : NAN;
+    const int width = 24;
+    const int filled = queue.empty() ? width : int(width * finished / queue.size());
+    const std::string bar = std::string(std::size_t(filled), '#') + std::string(std::size_t(width - filled), '.');
+    const std::string line = fmt::format("{}[{}] {}/{} cases: {} completed, {} failed, {} crashed/timeout/error, {} running, ETA {}",
+                                         prefix, bar, finished, queue.size(), completed, failed, broken, running.size(),
+                                         duration(eta));
+    if (tty) fmt::print(err, "\r{:<110}", line);
+    else fmt::print(err, "{}\n", line);
+    err.flush();
+  };
+
+  while ((next < queue.size() || !running.empty()) && !interrupted) {
+    while (next < queue.size() && int(running.size()) < jobs && !interrupted) {
+      const std::size_t i = queue[next++];
+      fs::remove(results_of(i), ec);
+      try {
+        running.push_back({i, spawn_case(exe, suite.cases[i], results_of(i), cases_dir / (suite.cases[i].id + ".log"),
+                                         threads, passive),
+                           std::chrono::steady_clock::now()});
+        state[i].status = "running";
+      } catch (const std::exception& e) {
+        state[i] = {"error", -1, 0.0, e.what()};
+        record(i);
+        ++finished;
+      }
+    }
+    // Reap whatever ended; kill what overran its time.
+    for (auto it = running.begin(); it != running.end();) {
+      int status = 0;
+      const pid_t r = waitpid(it->pid, &status, WNOHANG);
+      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - it->start).count();
+      if (r == 0) {
+        if (wall > suite.timeout_seconds && !it->timed_out) {
+          kill(-it->pid, SIGKILL);
+          it->timed_out = true;
+        }
+        ++it;
+        continue;
+      }
+      const std::size_t i = it->index;
+      CaseState& s = state[i];
+      s.wall = wall;
+      if (it->timed_out) {
+        s.status = "timeout";
+        s.detail = fmt::format("killed after {:.0f} s", suite.timeout_seconds);
+      } else if (WIFSIGNALED(status)) {
+        s.status = "crashed";
+        s.detail = fmt::format("signal {} ({})", WTERMSIG(status), strsignal(WTERMSIG(status)));
+      } else {
+        s.exit_code = WEXITSTATUS(status);
+        if (s.exit_code == 0 || s.exit_code == 1) {
+          const auto done = finished_state(results_of(i), suite.cases[i].configuration);
+          if (done) {
+            s = *done;
+            s.wall = wall;
+          } else {
+            s.status = "error";
+            s.detail = "the run ended without a results file";
+          }
+        } else {
+          s.status = "error";
+          s.detail = last_line(cases_dir / (suite.cases[i].id + ".log"));
+        }
+      }
+      fs::remove(results_of(i).string() + ".partial", ec);
+      record(i);
+      ++finished;
+      finished_wall += wall;
+      if (!tty && !request.quiet)
+        fmt::print(err, "{}case {}: {} ({:.3g} s){}\n", prefix, suite.cases[i].id, s.status, wall,
+                   s.detail.empty() ? "" : ", " + s.detail);
+      if (ranks == 1) write_manifest();
+      it = running.erase(it);
+    }
+    progress(false);
+    if (!running.empty()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+
+  if (interrupted) {
+    for (const Running& r : running) kill(-r.pid, SIGTERM);
+    for (const Running& r : running) waitpid(r.pid, nullptr, 0);
+    for (const Running& r : running) fs::remove(results_of(r.index).string() + ".partial", ec);
+    if (ranks == 1) write_manifest();
+    if (tty && !request.quiet) fmt::print(err, "\n");
+    fmt::print(err, "{}mpmvv suite: interrupted; {} cases finished; rerun the same command to resume\n", prefix, finished);
+    return finish_mpi(130);
+  }
+  progress(true);
+  if (tty && !request.quiet) fmt::print(err, "\n");
+
+#ifdef MPMVV_HAVE_MPI
+  if (under_mpi) MPI_Barrier(MPI_COMM_WORLD);
+#endif
+  int status = 0;
+  if (rank == 0) {
+    write_manifest();
+    // Every case's state, from the status files all ranks wrote.
+    std::string table = fmt::format("suite {} ({} cases) -> {}\n{:<48} {:<10} {:>9}  {}\n", suite.name, n, dir.string(),
+                                    "case", "status", "wall [s]", "detail");
+    std::map<std::string, int> counts;
+    for (std::size_t i = 0; i < n; ++i) {
+      const fs::path status_file = cases_dir / (suite.cases[i].id + ".json");
+      const std::string json = fs::exists(status_file) ? read_text(status_file) : "";
+      std::smatch m;
+      const std::string case_status =
+          std::regex_search(json, m, std::regex("\"status\": \"([a-z]+)\"")) ? m[1].str() : std::string("pending");
+      const double wall = std::regex_search(json, m, std::regex("\"wall_time_s\": ([0-9.eE+-]+)")) ? std::stod(m[1].str()) : 0.0;
+      const std::string detail =
+          std::regex_search(json, m, std::regex("\"detail\": \"((?:[^\"\\\\]|\\\\.)*)\"")) ? m[1].str() : std::string();
+      ++counts[case_status];
+      const std::string error = fs::exists(results_of(i)) ? headline_error(results_of(i)) : "";
+      table += fmt::format("{:<48} {:<10} {:>9.3g}  {}\n", suite.cases[i].id, case_status, wall,
+                           detail.empty() ? error : detail + (error.empty() ? "" : "; " + error));
+      if (case_status != "completed" && case_status != "failed") status = 1;
+    }
+    std::string totals;
+    for (const auto& [k, v] : counts) totals += fmt::format("{}{} {}", totals.empty() ? "" : ", ", v, k);
+    table += fmt::format("{} in {}\n", totals,
+                         duration(std::chrono::duration<double>(std::chrono::steady_clock::now() - suite_start).count()));
+    write_atomically(dir / "summary.txt", table);
+    fmt::print(out, "{}", table);
+  }
+  return finish_mpi(status);
+}
+
+}  // namespace mpmvv::app

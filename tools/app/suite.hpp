@@ -1,0 +1,49 @@
+// Suites (suites/README.md): a file of studies (a scene, its sweeps and
+// overrides) and expectations; the runner that runs every case in a process of
+// its own; the manifest that records what happened to each.
+#pragma once
+
+#include <iosfwd>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace mpmvv::app {
+
+// One run of a scene: the key=value overrides that make it, in order.
+struct SuiteCase {
+  std::string id;                      // "<study>-<key>=<value>-..."
+  std::string study;
+  std::string scene_file;              // as the runner passes it to `mpmvv run`
+  std::vector<std::string> overrides;  // "key=value"
+  std::string configuration;           // the resolved configuration (TOML), to recognise a finished case
+  std::map<std::string, std::string> keys;  // every resolved scene key, as JSON values
+};
+
+struct Suite {
+  std::string name;         // file stem
+  std::string file;
+  std::string description;
+  double timeout_seconds = 3600.0;
+  std::vector<SuiteCase> cases;
+};
+
+// Reads and checks a suite file and every case it makes; throws ConfigError
+// with the file, line and key of the first mistake. Nothing runs.
+Suite load_suite(const std::string& path);
+
+struct SuiteRequest {
+  std::string suite_file;
+  std::string output_dir;    // default: results/<suite name>
+  int jobs = 1;              // cases at once (per MPI rank)
+  bool quiet = false;
+  bool list = false;         // check the suite and print its cases; run nothing
+};
+
+// Exit status: 0 every case completed or was stopped by the solver (both are
+// results); 1 a case crashed, timed out or was refused; 2 bad input; 130
+// interrupted (rerun to resume).
+int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err);
+
+}  // namespace mpmvv::app
