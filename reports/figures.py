@@ -169,10 +169,7 @@ def work_precision(panels, title, y_label):
             axes.legend(fontsize=8)
         else:
             _no_data(axes)
-        axes.set_xlabel("wall time of the time loop [s]")
-        axes.set_ylabel(y_label)
-        axes.set_title(panel_title, fontsize=10)
-        axes.grid(True, which="both", alpha=0.3)
+        _label_panel(axes, "wall time of the time loop [s]", y_label, panel_title)
     _suptitle(figure, title)
     return figure
 
@@ -264,12 +261,17 @@ def error_spectra(panels, title, y_label):
             axes.legend(fontsize=8)
         else:
             _no_data(axes)
-        axes.set_xlabel("angular mode m around the circle")
-        axes.set_ylabel(y_label)
-        axes.set_title(panel_title, fontsize=10)
-        axes.grid(True, which="both", alpha=0.3)
+        _label_panel(axes, "angular mode m around the circle", y_label, panel_title)
     _suptitle(figure, title)
     return figure
+
+
+def _label_panel(axes, x_label, y_label, title):
+    """Axis labels, a panel title and a light grid on both scales."""
+    axes.set_xlabel(x_label)
+    axes.set_ylabel(y_label)
+    axes.set_title(title, fontsize=10)
+    axes.grid(True, which="both", alpha=0.3)
 
 
 def _suptitle(figure, title):

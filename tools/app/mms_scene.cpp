@@ -24,6 +24,21 @@ const char* to_string(ProbeQuantity q) {
   return "?";
 }
 
+KeySpec seeding_key() {
+  const double inf = std::numeric_limits<double>::infinity();
+#ifdef MPMVV_HAVE_CGAL
+  const std::vector<std::string> choices = {"exact", "centre"};
+  const std::string fallback = "exact";
+#else
+  const std::vector<std::string> choices = {"centre"};
+  const std::string fallback = "centre";
+#endif
+  return {"seeding", KeyKind::text, fallback,
+          "exact: particles in cells the boundary cuts get the exact clipped volume and centroid (CGAL), so the body's "
+          "volume is exact; centre: a particle wherever its sub-cell centre lies in the body (a staircase boundary)",
+          -inf, inf, false, false, choices};
+}
+
 std::vector<KeySpec> material_keys(const std::string& default_material, double lambda, double mu, double density) {
   const double inf = std::numeric_limits<double>::infinity();
   return {
@@ -92,6 +107,10 @@ class MmsCase final : public SceneCase, private RunObserver {
       : config_(config), setup_(problem.setup(config)), options_(solver_options(config)),
         loop_(time_loop_options(config)) {
     options_.geometry = setup_.geometry;
+    exact_seeding_ = config_.text("seeding") == "exact";
+#ifdef MPMVV_HAVE_CGAL
+    if (exact_seeding_ && !setup_.body) throw ConfigError("this scene has no exact body: use seeding = \"centre\"");
+#endif
     // A probe must be a material point of the body.
     for (const ProbeLine& line : setup_.lines)
       for (const Vec2& X : line.reference)
@@ -128,6 +147,17 @@ class MmsCase final : public SceneCase, private RunObserver {
   double cell_size() const override { return setup_.grid.h; }
   Geometry geometry() const override { return setup_.geometry; }
   std::string body_force_kind() const override { return setup_.fast_body_force ? "closed form" : "derived"; }
+  std::string seeding() const override { return exact_seeding_ ? "exact" : "centre"; }
+  double particle_volume() const override { return particle_volume_; }
+  double body_volume() const override {
+#ifdef MPMVV_HAVE_CGAL
+    if (setup_.body) {
+      const AreaMoments m = setup_.body->whole();
+      return setup_.geometry == Geometry::axisymmetric ? m.moment_x : m.area;
+    }
+#endif
+    return std::numeric_limits<double>::quiet_NaN();
+  }
   std::size_t particle_count() const override { return stepper_ ? stepper_->model().particles.size() : 0; }
   const ErrorTable& errors() const override { return errors_; }
 
@@ -203,34 +233,88 @@ class MmsCase final : public SceneCase, private RunObserver {
     return out;
   }
 
-  // Particles on a regular sub-lattice of every cell, kept where their centre
-  // lies in the body; in cell order, so neighbours in memory are neighbours in
-  // space. Each starts in the exact state at t = 0, from the same definition
-  // as the force. In r-z a particle's volume is per radian: R_p times its area.
-  void seed_particles(Particles& P) const {
+  // Particles on a regular sub-lattice of every cell, in cell order, so that
+  // neighbours in memory are neighbours in space. With exact seeding a
+  // sub-cell the boundary cuts holds the part of the body inside it: its exact
+  // area and centroid; slivers under a tenth of a sub-cell join the largest
+  // piece of their cell, and a clipped particle's domain shrinks to its area.
+  // With centre seeding a particle sits wherever its sub-cell centre lies in
+  // the body. Each starts in the exact state at t = 0, from the same
+  // definition as the force. In r-z a particle's volume is per radian: the
+  // integral of r over its area.
+  struct Piece {
+    Vec2 centroid;
+    double area;      // int dA
+    double moment_r;  // int x dA (r in r-z)
+  };
+
+  std::vector<Piece> pieces_of_cell(int i, int j, int ppd) const {
+    const GridGeometry& grid = setup_.grid;
+    const double spacing = grid.h / ppd;
+    std::vector<Piece> pieces;
+    for (int b = 0; b < ppd; ++b)
+      for (int a = 0; a < ppd; ++a) {
+        const Vec2 lower = grid.node_position(i, j) + spacing * Vec2(a, b);
+        const Vec2 centre = lower + 0.5 * spacing * Vec2(1.0, 1.0);
+        const Piece whole{centre, spacing * spacing, spacing * spacing * centre.x()};
+#ifdef MPMVV_HAVE_CGAL
+        if (exact_seeding_) {
+          const Body& body = *setup_.body;
+          if (body.boundary_may_meet(lower, lower + spacing * Vec2(1.0, 1.0))) {
+            const AreaMoments m = body.clip(lower, lower + spacing * Vec2(1.0, 1.0));
+            if (m.area > 1e-14 * spacing * spacing) pieces.push_back({m.centroid(), m.area, m.moment_x});
+          } else if (body.contains(centre)) {
+            pieces.push_back(whole);
+          }
+          continue;
+        }
+#endif
+        if (setup_.contains(centre)) pieces.push_back(whole);
+      }
+    // Slivers join the largest piece of the cell.
+    const double sliver = 0.1 * spacing * spacing;
+    auto largest = std::max_element(pieces.begin(), pieces.end(),
+                                    [](const Piece& x, const Piece& y) { return x.area < y.area; });
+    if (largest != pieces.end()) {
+      Piece merged = *largest;
+      std::vector<Piece> kept;
+      for (auto it = pieces.begin(); it != pieces.end(); ++it) {
+        if (it == largest) continue;
+        if (it->area < sliver) {
+          merged.centroid = (merged.centroid * merged.area + it->centroid * it->area) / (merged.area + it->area);
+          merged.area += it->area;
+          merged.moment_r += it->moment_r;
+        } else {
+          kept.push_back(*it);
+        }
+      }
+      kept.push_back(merged);
+      pieces = std::move(kept);
+    }
+    return pieces;
+  }
+
+  void seed_particles(Particles& P) {
     const GridGeometry& grid = setup_.grid;
     const int ppd = int(config_.integer("particles_per_direction"));
     const double spacing = grid.h / ppd;
-    std::vector<Vec2> X;
+    std::vector<Piece> pieces;
     for (int j = 0; j < grid.cells_y; ++j)
       for (int i = 0; i < grid.cells_x; ++i)
-        for (int b = 0; b < ppd; ++b)
-          for (int a = 0; a < ppd; ++a) {
-            const Vec2 x = grid.node_position(i, j) + spacing * Vec2(a + 0.5, b + 0.5);
-            if (setup_.contains(x)) X.push_back(x);
-          }
-    P.resize(X.size());
+        for (const Piece& piece : pieces_of_cell(i, j, ppd)) pieces.push_back(piece);
+    P.resize(pieces.size());
     const bool axisymmetric = setup_.geometry == Geometry::axisymmetric;
     if (axisymmetric) {
-      P.hoop_stretch.resize(X.size());
-      P.hoop_stress.resize(X.size());
+      P.hoop_stretch.resize(pieces.size());
+      P.hoop_stress.resize(pieces.size());
     }
-    const double area = spacing * spacing;
     const double density = setup_.solution->density();
-    for (std::size_t p = 0; p < X.size(); ++p) {
-      const mms::ExactFields f = setup_.solution->fields(X[p], 0.0);
-      const double reference_volume = axisymmetric ? X[p].x() * area : area;
-      P.reference_position[p] = X[p];
+    particle_volume_ = 0.0;
+    for (std::size_t p = 0; p < pieces.size(); ++p) {
+      const Vec2 X = pieces[p].centroid;
+      const mms::ExactFields f = setup_.solution->fields(X, 0.0);
+      const double reference_volume = axisymmetric ? pieces[p].moment_r : pieces[p].area;
+      P.reference_position[p] = X;
       P.position[p] = f.position;
       P.velocity[p] = f.velocity;
       P.deformation_gradient[p] = f.deformation_gradient;
@@ -238,12 +322,18 @@ class MmsCase final : public SceneCase, private RunObserver {
       P.reference_volume[p] = reference_volume;
       P.volume[p] = f.J * reference_volume;
       P.mass[p] = density * reference_volume;
+      particle_volume_ += reference_volume;
       if (axisymmetric) {
         P.hoop_stretch[p] = f.hoop_stretch;
         P.hoop_stress[p] = f.cauchy_stress_33;
       }
     }
-    if (options_.method != Method::linear) P.half_size.assign(X.size(), Vec2(0.5 * spacing, 0.5 * spacing));
+    if (options_.method != Method::linear) {
+      P.half_size.resize(pieces.size());
+      for (std::size_t p = 0; p < pieces.size(); ++p)
+        P.half_size[p] = 0.5 * std::sqrt(pieces[p].area) * Vec2(1.0, 1.0);
+    }
+    (void)spacing;
   }
 
   void seed_tracers(std::vector<Vec2>& tracers) {
@@ -345,6 +435,8 @@ class MmsCase final : public SceneCase, private RunObserver {
 
   Config config_;
   Fault fault_ = Fault::none;
+  bool exact_seeding_ = false;
+  double particle_volume_ = 0.0;
   ProblemSetup setup_;
   SolverOptions options_;
   TimeLoopOptions loop_;

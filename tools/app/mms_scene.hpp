@@ -12,6 +12,9 @@
 
 #include "mms/exact_solution.hpp"
 #include "scene.hpp"
+#ifdef MPMVV_HAVE_CGAL
+#include "body.hpp"
+#endif
 
 namespace mpmvv::app {
 
@@ -55,6 +58,9 @@ struct ProblemSetup {
   Geometry geometry = Geometry::plane_strain;
   GridGeometry grid;
   std::function<bool(const Vec2&)> contains;  // the body, in reference coordinates
+#ifdef MPMVV_HAVE_CGAL
+  std::optional<Body> body;                    // the same body, exactly (seeding = "exact")
+#endif
   std::vector<ProbeLine> lines;
   std::vector<ProbePoint> points;
   std::optional<ProbeCircle> circle;
@@ -76,6 +82,10 @@ const std::vector<MmsProblem>& mms_problems();
 const MmsProblem* find_mms_problem(const std::string& name);
 
 std::unique_ptr<SceneCase> build_mms_case(const Config& config, const MmsProblem& problem);
+
+// The seeding key every manufactured problem accepts: "exact" (clipped
+// volumes, CGAL) by default when built with CGAL, else "centre".
+KeySpec seeding_key();
 
 // Material keys every manufactured problem accepts, with its defaults.
 std::vector<KeySpec> material_keys(const std::string& default_material, double lambda, double mu, double density);

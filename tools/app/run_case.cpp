@@ -121,6 +121,10 @@ void write_results_file(const std::string& path, const RunRequest& request, cons
   root.set_attribute("h", scene.cell_size());
   root.set_attribute("geometry", to_string(scene.geometry()));
   root.set_attribute("body_force", scene.body_force_kind());
+  root.set_attribute("seeding", scene.seeding());
+  root.set_attribute("particle_volume", scene.particle_volume());
+  root.set_attribute("body_volume", scene.body_volume());
+  root.set_attribute("volume_error", scene.particle_volume() / scene.body_volume() - 1.0);
   root.set_attribute("dt", o.dt_first);
   root.set_attribute("dt_min", o.dt_min);
   root.set_attribute("dt_max", o.dt_max);

@@ -41,6 +41,11 @@ class SceneCase {
   virtual Geometry geometry() const = 0;
   // How the body force is evaluated ("derived", "closed form"), or "none".
   virtual std::string body_force_kind() const = 0;
+  // How particles were seeded ("exact", "centre"), their total reference
+  // volume and the body's exact volume (NaN when not known exactly).
+  virtual std::string seeding() const = 0;
+  virtual double particle_volume() const = 0;
+  virtual double body_volume() const = 0;
   // Writes particles and probes under `root` (the errors are written from errors()).
   virtual void write_results(h5::Group& root) const = 0;
   virtual const ErrorTable& errors() const = 0;

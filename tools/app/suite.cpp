@@ -675,12 +675,18 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
   std::size_t next = 0, finished = 0;
   double finished_wall = 0.0;
   const auto suite_start = std::chrono::steady_clock::now();
-  auto last_progress = suite_start - std::chrono::seconds(10);
+  auto last_progress = suite_start - std::chrono::seconds(60);
+  std::size_t last_finished = 0;
+  // A terminal line rewritten twice a second; in a log a line when a case
+  // ends (printed where it is reaped) or once a minute.
   auto progress = [&](bool force) {
     if (request.quiet) return;
     const auto now = std::chrono::steady_clock::now();
-    if (!force && now - last_progress < std::chrono::milliseconds(tty ? 500 : 10000)) return;
+    if (!force && now - last_progress < std::chrono::milliseconds(tty ? 500 : 60000) &&
+        (tty || finished == last_finished))
+      return;
     last_progress = now;
+    last_finished = finished;
     std::size_t completed = 0, failed = 0, broken = 0;
     for (std::size_t i : queue) {
       if (state[i].status == "completed") ++completed;

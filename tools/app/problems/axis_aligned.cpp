@@ -26,6 +26,7 @@ std::vector<KeySpec> keys() {
   };
   k.insert(k.end(), own.begin(), own.end());
   // mu = 3846.15 Pa and K = 8333.33 Pa (lambda = K - 2 mu / 3), rho_0 = 1: E = 1e4 Pa, c = 100 m/s.
+  k.push_back(seeding_key());
   const std::vector<KeySpec> material = material_keys("neo-hookean", 5769.23, 3846.15, 1.0);
   k.insert(k.end(), material.begin(), material.end());
   return k;
@@ -67,6 +68,9 @@ ProblemSetup setup(const Config& c) {
   s.grid = GridGeometry::walled(Vec2::Zero(), L / cells, cells, one_d ? 2 : cells);
   const double height = one_d ? 2.0 * L / cells : L;
   s.contains = [L, height](const Vec2& X) { return X.x() >= 0.0 && X.x() <= L && X.y() >= 0.0 && X.y() <= height; };
+#ifdef MPMVV_HAVE_CGAL
+  s.body = Body::rectangle(Vec2::Zero(), Vec2(L, height));
+#endif
 
   const int n = int(c.integer("probe_points"));
   const double middle_y = 0.5 * height;

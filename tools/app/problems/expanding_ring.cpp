@@ -30,6 +30,7 @@ std::vector<KeySpec> keys() {
   };
   k.insert(k.end(), own.begin(), own.end());
   // E = 1e7 Pa, nu = 0: lambda = 0, mu = E / 2; rho_0 = 1000.
+  k.push_back(seeding_key());
   const std::vector<KeySpec> material = material_keys("neo-hookean", 0.0, 5e6, 1000.0);
   k.insert(k.end(), material.begin(), material.end());
   return k;
@@ -72,6 +73,9 @@ ProblemSetup setup(const Config& c) {
     const double R = X.norm();
     return R >= ri && R <= ro;
   };
+#ifdef MPMVV_HAVE_CGAL
+  s.body = Body::annulus(Vec2::Zero(), ri, ro);
+#endif
   const int n = int(c.integer("probe_points"));
   const double angles[3] = {0.0, pi / 4.0, -pi / 4.0};
   const char* names[3] = {"theta0", "theta_plus45", "theta_minus45"};

@@ -36,6 +36,7 @@ std::vector<KeySpec> keys() {
        -inf, inf, false, false, {"closed-form", "derived"}},
   };
   k.insert(k.end(), ring.begin(), ring.end());
+  k.push_back(seeding_key());
   const std::vector<KeySpec> material = material_keys("neo-hookean", 577.0, 385.0, 1000.0);
   k.insert(k.end(), material.begin(), material.end());
   return k;
@@ -73,6 +74,9 @@ ProblemSetup setup(const Config& c) {
     const double R = X.norm();
     return R >= p.inner_radius && R <= p.outer_radius;
   };
+#ifdef MPMVV_HAVE_CGAL
+  s.body = Body::annulus(Vec2::Zero(), p.inner_radius, p.outer_radius);
+#endif
   const int n = int(c.integer("probe_points"));
   const double angles[3] = {0.0, pi / 4.0, -pi / 4.0};
   const char* names[3] = {"theta0", "theta_plus45", "theta_minus45"};

@@ -26,6 +26,7 @@ std::vector<KeySpec> keys() {
       {"probe_points", KeyKind::integer, std::int64_t(51), "material points on each probe line", 2, 100000},
   };
   k.insert(k.end(), own.begin(), own.end());
+  k.push_back(seeding_key());
   const std::vector<KeySpec> material = material_keys("neo-hookean", 577.0, 385.0, 1000.0);
   k.insert(k.end(), material.begin(), material.end());
   return k;
@@ -55,6 +56,9 @@ ProblemSetup setup(const Config& c) {
   if (ro - ri < h)
     c.reject("cells", fmt::format("the wall is {} m thick but a cell is {:.4g} m: use more cells", ro - ri, h));
   s.contains = [ri, ro, H](const Vec2& X) { return X.x() >= ri && X.x() <= ro && X.y() >= 0.0 && X.y() <= H; };
+#ifdef MPMVV_HAVE_CGAL
+  s.body = Body::rectangle(Vec2(ri, 0.0), Vec2(ro, H));
+#endif
 
   const int n = int(c.integer("probe_points"));
   const double middle = 0.5 * (ri + ro);

@@ -1,0 +1,119 @@
+// Exact body geometry (tools/app/body.hpp): areas and first moments of whole
+// bodies and of their parts in boxes, from CGAL's exact Boolean intersection
+// and Green's theorem; the inside test and the cut-box test the seeding uses.
+#include <gtest/gtest.h>
+
+#ifdef MPMVV_HAVE_CGAL
+
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include "tools/app/body.hpp"
+#include "tools/app/scene.hpp"
+
+namespace {
+
+using mpmvv::Vec2;
+using mpmvv::app::AreaMoments;
+using mpmvv::app::Body;
+using std::numbers::pi;
+
+// Round-off of sums of order one: a few 1e-16 per piece.
+constexpr double kRoundOff = 1e-13;
+
+}  // namespace
+
+// Whole bodies: areas and centroids of a disk, a ring, a rectangle and a
+// plate with a hole equal their closed forms.
+TEST(Body, WholeAreasAndCentroidsAreExact) {
+  const AreaMoments disk = Body::disk(Vec2(0.3, -0.2), 0.5).whole();
+  EXPECT_NEAR(disk.area, pi * 0.25, kRoundOff);
+  EXPECT_NEAR(disk.centroid().x(), 0.3, kRoundOff);
+  EXPECT_NEAR(disk.centroid().y(), -0.2, kRoundOff);
+  EXPECT_NEAR(Body::annulus(Vec2::Zero(), 0.75, 1.25).whole().area, pi, kRoundOff);
+  const AreaMoments plate = Body::polygon({Vec2(0, 0), Vec2(2, 0), Vec2(2, 1), Vec2(0, 1)},
+                                         {{Vec2(0.5, 0.25), Vec2(1, 0.25), Vec2(1, 0.75), Vec2(0.5, 0.75)}})
+                                .whole();
+  EXPECT_NEAR(plate.area, 1.75, kRoundOff);
+  // Centroid of the plate with its hole: (2 * 1 - 0.25 * 0.75) / 1.75.
+  EXPECT_NEAR(plate.centroid().x(), (2.0 * 1.0 - 0.25 * 0.75) / 1.75, kRoundOff);
+  EXPECT_NEAR(Body::rectangle(Vec2(0.25, 0), Vec2(1, 1)).whole().area, 0.75, kRoundOff);
+}
+
+// Parts in boxes: a quarter disk has centroid 4 r / (3 pi) on each axis; a
+// half ring has its centroid at 4 (R_o^3 - R_i^3) / (3 pi (R_o^2 - R_i^2)).
+TEST(Body, ClippedPartsHaveTheirClosedForms) {
+  const AreaMoments quarter = Body::disk(Vec2::Zero(), 1.0).clip(Vec2(0, 0), Vec2(2, 2));
+  EXPECT_NEAR(quarter.area, pi / 4.0, kRoundOff);
+  EXPECT_NEAR(quarter.centroid().x(), 4.0 / (3.0 * pi), kRoundOff);
+  const AreaMoments half = Body::annulus(Vec2::Zero(), 0.75, 1.25).clip(Vec2(-2, 0), Vec2(2, 2));
+  EXPECT_NEAR(half.centroid().x(), 0.0, kRoundOff);
+  EXPECT_NEAR(half.centroid().y(), 4.0 * (1.25 * 1.25 * 1.25 - 0.75 * 0.75 * 0.75) / (3.0 * pi * (1.25 * 1.25 - 0.75 * 0.75)),
+              kRoundOff);
+  // A circular segment x > 1/2 of the unit disk.
+  EXPECT_NEAR(Body::disk(Vec2::Zero(), 1.0).clip(Vec2(0.5, -2), Vec2(2, 2)).area,
+              std::acos(0.5) - 0.5 * std::sqrt(0.75), kRoundOff);
+}
+
+// Cutting a body into grid cells, as the seeding does (the cut-box test, the
+// exact clip where it passes, the inside test elsewhere), gives back its area
+// and first moments: the particles of a ring hold exactly its volume.
+TEST(Body, CellsAddUpToTheWhole) {
+  for (const Body& body : {Body::annulus(Vec2::Zero(), 0.75, 1.25), Body::disk(Vec2(0.1, 0.05), 0.9),
+                           Body::rectangle(Vec2(-0.33, -0.71), Vec2(1.07, 0.2))}) {
+    const AreaMoments whole = body.whole();
+    const int n = 48;
+    const double h = 3.0 / n;
+    AreaMoments sum;
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const Vec2 lo(-1.5 + i * h, -1.5 + j * h), hi = lo + Vec2(h, h), centre = lo + 0.5 * Vec2(h, h);
+        AreaMoments part;
+        if (body.boundary_may_meet(lo, hi)) part = body.clip(lo, hi);
+        else if (body.contains(centre)) part = {h * h, h * h * centre.x(), h * h * centre.y()};
+        sum.area += part.area;
+        sum.moment_x += part.moment_x;
+        sum.moment_y += part.moment_y;
+      }
+    EXPECT_NEAR(sum.area, whole.area, kRoundOff);
+    EXPECT_NEAR(sum.moment_x, whole.moment_x, kRoundOff);
+    EXPECT_NEAR(sum.moment_y, whole.moment_y, kRoundOff);
+  }
+}
+
+// The cut-box test has no false negatives: every random box the boundary
+// really cuts (its clipped area strictly between 0 and the box's area)
+// passes it; and the inside test agrees with the clip for boxes that pass no boundary.
+TEST(Body, CutTestMissesNoCutBoxAndInsideTestAgreesWithClip) {
+  const Body body = Body::annulus(Vec2::Zero(), 0.75, 1.25).plus(Body::rectangle(Vec2(1.0, -0.1), Vec2(1.4, 0.1)));
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.5, 1.5), size(0.01, 0.3);
+  int cut = 0;
+  for (int k = 0; k < 2000; ++k) {
+    const Vec2 lo(u(rng), u(rng));
+    const double s = size(rng);
+    const Vec2 hi = lo + Vec2(s, s);
+    const double area = body.clip(lo, hi).area;
+    const bool really_cut = area > 1e-12 * s * s && area < (1.0 - 1e-12) * s * s;
+    if (really_cut) {
+      ++cut;
+      EXPECT_TRUE(body.boundary_may_meet(lo, hi)) << lo.transpose() << " size " << s;
+    } else if (!body.boundary_may_meet(lo, hi)) {
+      EXPECT_EQ(body.contains(lo + 0.5 * Vec2(s, s)), area > 0.5 * s * s) << lo.transpose() << " size " << s;
+    }
+  }
+  EXPECT_GT(cut, 200);  // the sample does exercise cut boxes
+}
+
+// The ring scene seeded exactly holds the ring's volume pi to round-off.
+TEST(Body, RingSceneHoldsExactlyTheRingsVolume) {
+  mpmvv::app::Config config("ring", mpmvv::app::find_scene_type("ring")->keys());
+  for (const char* o : {"cells=48", "end_time=0.01", "output_times=0.01", "seeding=exact"}) config.set_from_text(o);
+  auto scene = mpmvv::app::find_scene_type("ring")->build(config);
+  ASSERT_TRUE(scene->run({}).completed);
+  EXPECT_NEAR(scene->particle_volume(), pi, kRoundOff);
+  EXPECT_NEAR(scene->body_volume(), pi, kRoundOff);
+}
+
+#endif  // MPMVV_HAVE_CGAL
