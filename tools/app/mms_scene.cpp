@@ -9,7 +9,7 @@
 #include <fmt/format.h>
 
 #ifdef MPMVV_HAVE_FFTW
-#include "spectrum.hpp"
+#include "analytic/fft.hpp"
 #endif
 
 namespace mpmvv::app {
@@ -138,7 +138,7 @@ class MmsCase final : public SceneCase, private RunObserver {
     seed_tracers(model.tracers);
     std::shared_ptr<BodyForce> force = setup_.fast_body_force;
     if (!force) force = std::make_shared<mms::DerivedBodyForce>(setup_.solution);
-    if (fault_ == Fault::no_body_force) force = nullptr;
+    if (fault_ == Fault::no_body_force || setup_.force_free) force = nullptr;
     stepper_ = make_stepper(std::move(model), options_, setup_.material, std::move(force));
     outcome_ = run_time_loop(*stepper_, loop_, *this, progress);
     return outcome_;
@@ -146,7 +146,13 @@ class MmsCase final : public SceneCase, private RunObserver {
 
   double cell_size() const override { return setup_.grid.h; }
   Geometry geometry() const override { return setup_.geometry; }
-  std::string body_force_kind() const override { return setup_.fast_body_force ? "closed form" : "derived"; }
+  std::string body_force_kind() const override {
+    return setup_.force_free ? "none" : setup_.fast_body_force ? "closed form" : "derived";
+  }
+  std::vector<std::pair<std::string, double>> measurements() const override {
+    if (!setup_.measure || point_simulated_.empty() || point_time_.size() < 8) return {};
+    return setup_.measure(point_time_, point_simulated_.front());
+  }
   std::string seeding() const override { return exact_seeding_ ? "exact" : "centre"; }
   double particle_volume() const override { return particle_volume_; }
   double body_volume() const override {
@@ -413,7 +419,7 @@ class MmsCase final : public SceneCase, private RunObserver {
       circle_simulated_.push_back(std::move(sim));
       circle_exact_.push_back(std::move(ex));
 #ifdef MPMVV_HAVE_FFTW
-      circle_spectrum_.push_back(amplitude_spectrum(err));
+      circle_spectrum_.push_back(analytic::amplitude_spectrum(err));
 #endif
     }
     // Volume-weighted displacement error over all particles.
@@ -462,10 +468,11 @@ MmsProblem ring_problem();
 MmsProblem axis_aligned_problem();
 MmsProblem expanding_ring_problem();
 MmsProblem rz_cylinder_problem();
+MmsProblem vibrating_bar_problem();
 
 const std::vector<MmsProblem>& mms_problems() {
   static const std::vector<MmsProblem> problems = {ring_problem(), axis_aligned_problem(), expanding_ring_problem(),
-                                                   rz_cylinder_problem()};
+                                                   rz_cylinder_problem(), vibrating_bar_problem()};
   return problems;
 }
 

@@ -64,6 +64,13 @@ struct ProblemSetup {
   std::vector<ProbeLine> lines;
   std::vector<ProbePoint> points;
   std::optional<ProbeCircle> circle;
+  // A classical exact solution that needs no force: the body-force stage is
+  // left out (the exact motion still gives the initial state and the errors).
+  bool force_free = false;
+  // Scalars measured from the first probe point's history (time, value) at
+  // the end of a run, e.g. a period and an amplitude with their exact values.
+  std::function<std::vector<std::pair<std::string, double>>(const std::vector<double>&, const std::vector<double>&)>
+      measure;
   // A closed form that equals the derived force (tests/test_manufactured.cpp
   // shows it), used instead of automatic differentiation for speed; absent
   // otherwise.

@@ -130,6 +130,10 @@ void write_results_file(const std::string& path, const RunRequest& request, cons
   root.set_attribute("dt_max", o.dt_max);
   scene.write_results(root);
   write_errors(root, scene.errors(), scene.error_description());
+  if (const auto m = scene.measurements(); !m.empty()) {
+    h5::Group g = root.create_group("measurements");
+    for (const auto& [name, value] : m) g.set_attribute(name, value);
+  }
   file.flush();
 }
 
@@ -234,6 +238,7 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
                config.text("method"), o.failure_time, o.failure_step, o.failure_particle, o.failure_reason,
                o.failure_detail);
   print_error_table(out, scene->errors());
+  print_measurements(out, scene->measurements());
   fmt::print(out, "results: {}\n", output);
   return o.completed ? 0 : 1;
 }

@@ -102,6 +102,10 @@ void print_error_table(std::ostream& out, const ErrorTable& errors) {
   }
 }
 
+void print_measurements(std::ostream& out, const std::vector<std::pair<std::string, double>>& measurements) {
+  for (const auto& [name, value] : measurements) fmt::print(out, "{:<28} {:.9g}\n", name, value);
+}
+
 void write_errors(h5::Group& root, const ErrorTable& errors, const std::string& description) {
   h5::Group e = root.create_group("errors");
   e.set_attribute("description", description);

@@ -46,6 +46,8 @@ class SceneCase {
   virtual std::string seeding() const = 0;
   virtual double particle_volume() const = 0;
   virtual double body_volume() const = 0;
+  // Scalars the scene measures at the end (name, value), for /measurements.
+  virtual std::vector<std::pair<std::string, double>> measurements() const { return {}; }
   // Writes particles and probes under `root` (the errors are written from errors()).
   virtual void write_results(h5::Group& root) const = 0;
   virtual const ErrorTable& errors() const = 0;
@@ -74,6 +76,9 @@ TimeLoopOptions time_loop_options(const Config& config);
 
 // The error table a person reads at the end of a run.
 void print_error_table(std::ostream& out, const ErrorTable& errors);
+
+// Prints the measurements, one per line.
+void print_measurements(std::ostream& out, const std::vector<std::pair<std::string, double>>& measurements);
 
 // Writes /errors: time and one dataset per column.
 void write_errors(h5::Group& root, const ErrorTable& errors, const std::string& description);

@@ -1,0 +1,96 @@
+// The axial vibration of a fixed-free bar (PROBLEMS.md section 5), no forcing:
+// a strip between roller walls (uniaxial strain, c = sqrt((lambda + 2 mu) /
+// rho)), its fixed end on the left wall and its free end short of the right
+// one, started in its first mode, v0 = V sin(pi X / 2L). Probes: the line along
+// the bar reads the displacement; the free end's history gives the period
+// (FFTW) and the amplitude, against omega_1 = pi c / 2L and V / omega_1.
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "analytic/vibrating_bar.hpp"
+#ifdef MPMVV_HAVE_FFTW
+#include "analytic/fft.hpp"
+#endif
+#include "tools/app/mms_scene.hpp"
+
+namespace mpmvv::app {
+
+namespace {
+
+std::vector<KeySpec> keys() {
+  const double inf = std::numeric_limits<double>::infinity();
+  // Steel: one period 4 L / c = 6.71e-4 s for L = 1 m; five periods.
+  std::vector<KeySpec> k = solver_keys(32, 0.00336, {0.00084, 0.00168, 0.00252, 0.00336});
+  const std::vector<KeySpec> own = {
+      {"length", KeyKind::real, 1.0, "L, the length of the bar [m]", 0.0, inf, true},
+      {"velocity_amplitude", KeyKind::real, 1.0,
+       "V of v0 = V sin(pi X / 2L) [m/s]; the strain amplitude is V / c", 0.0, inf, true},
+      {"probe_points", KeyKind::integer, std::int64_t(51), "material points on the probe line", 2, 100000},
+  };
+  k.insert(k.end(), own.begin(), own.end());
+  k.push_back(seeding_key());
+  // Steel, E = 207 GPa, nu = 0.3.
+  const std::vector<KeySpec> material = material_keys("linear-elastic", 119.42e9, 79.615e9, 7850.0);
+  k.insert(k.end(), material.begin(), material.end());
+  return k;
+}
+
+ProblemSetup setup(const Config& c) {
+  ProblemSetup s;
+  s.material = material_from(c);
+  s.geometry = Geometry::plane_strain;
+  s.force_free = true;
+  const double L = c.real("length");
+  const double M = std::visit(
+      [](const auto& m) {
+        if constexpr (requires { m.lambda; }) return m.lambda + 2.0 * m.mu;
+        else return m.p_wave_modulus();
+      },
+      s.material);
+  const analytic::VibratingBar bar{L, std::sqrt(M / c.real("density"))};
+  const analytic::VibratingBarMotion motion{bar, c.real("velocity_amplitude")};
+  s.solution = mms::make_solution(motion, s.material, c.real("density"), s.geometry);
+
+  // The strip: two cells high between roller walls; the right wall four cells
+  // beyond the free end.
+  const int cells = int(c.integer("cells"));
+  const double h = L / cells;
+  s.grid = GridGeometry::walled(Vec2::Zero(), h, cells + 4, 2);
+  const double height = 2.0 * h;
+  s.contains = [L, height](const Vec2& X) { return X.x() >= 0.0 && X.x() <= L && X.y() >= 0.0 && X.y() <= height; };
+#ifdef MPMVV_HAVE_CGAL
+  s.body = Body::rectangle(Vec2::Zero(), Vec2(L, height));
+#endif
+  ProbeLine line{"line_axis", ProbeQuantity::displacement_x, "reference_x", {}, {}, std::nullopt};
+  line.reference = points_on_segment(Vec2(0.0, 0.5 * height), Vec2(L, 0.5 * height), int(c.integer("probe_points")));
+  for (const Vec2& X : line.reference) line.parameter.push_back(X.x());
+  s.lines.push_back(std::move(line));
+  s.points.push_back({"point_free_end", ProbeQuantity::displacement_x, Vec2(L, 0.5 * height)});
+  const double V = motion.velocity_amplitude;
+  s.measure = [bar, V](const std::vector<double>& t, const std::vector<double>& u) {
+    double amplitude = 0.0;
+    for (double x : u) amplitude = std::max(amplitude, std::abs(x));
+    const double exact_amplitude = V / bar.frequency(1);
+    std::vector<std::pair<std::string, double>> m = {{"amplitude", amplitude},
+                                                     {"amplitude_exact", exact_amplitude},
+                                                     {"amplitude_error", amplitude / exact_amplitude - 1.0},
+                                                     {"period_exact", bar.period(1)}};
+#ifdef MPMVV_HAVE_FFTW
+    const double period = 1.0 / analytic::dominant_frequency(t, u);
+    m.push_back({"period", period});
+    m.push_back({"period_error", period / bar.period(1) - 1.0});
+#endif
+    return m;
+  };
+  return s;
+}
+
+}  // namespace
+
+MmsProblem vibrating_bar_problem() {
+  return {"vibrating-bar", "axial vibration of a fixed-free bar, first mode, no forcing (PROBLEMS.md section 5)", keys,
+          setup};
+}
+
+}  // namespace mpmvv::app
