@@ -49,10 +49,14 @@ struct VibratingBarMotion {
   double velocity_amplitude;  // V [m/s]
 
   template <class S>
-  Eigen::Matrix<S, 2, 1> position(const Eigen::Matrix<S, 2, 1>& X, const S& t) const {
+  Eigen::Matrix<S, 2, 1> displacement(const Eigen::Matrix<S, 2, 1>& X, const S& t) const {
     using std::sin;
     const S k(bar.wavenumber(1)), omega(bar.frequency(1));
-    return {X.x() + S(velocity_amplitude / bar.frequency(1)) * sin(k * X.x()) * sin(omega * t), X.y()};
+    return {S(velocity_amplitude / bar.frequency(1)) * sin(k * X.x()) * sin(omega * t), S(0.0)};
+  }
+  template <class S>
+  Eigen::Matrix<S, 2, 1> position(const Eigen::Matrix<S, 2, 1>& X, const S& t) const {
+    return X + displacement(X, t);
   }
   double length_scale() const { return bar.length; }
   double time_scale() const { return bar.period(1); }
