@@ -5,6 +5,7 @@
 #include <complex>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 
@@ -77,6 +78,30 @@ double dominant_frequency(const std::vector<double>& t, const std::vector<double
   }
   const double dt = duration / double(m - 1);
   return (double(peak) + offset) / (double(m) * dt);
+}
+
+double crossing_period(const std::vector<double>& t, const std::vector<double>& value, double estimate) {
+  std::vector<double> crossings;
+  for (std::size_t i = 1; i < t.size(); ++i) {
+    const double a = value[i - 1], b = value[i];
+    if (!((a < 0.0 && b >= 0.0) || (a > 0.0 && b <= 0.0))) continue;
+    const double when = t[i - 1] + (t[i] - t[i - 1]) * a / (a - b);
+    if (crossings.empty() || when - crossings.back() > 0.25 * estimate) crossings.push_back(when);
+  }
+  const std::size_t n = crossings.size();
+  if (n < 3) return std::numeric_limits<double>::quiet_NaN();
+  // Least-squares slope of crossing time against crossing number.
+  double mean_k = 0.0, mean_t = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    mean_k += double(k) / double(n);
+    mean_t += crossings[k] / double(n);
+  }
+  double sxy = 0.0, sxx = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    sxy += (double(k) - mean_k) * (crossings[k] - mean_t);
+    sxx += (double(k) - mean_k) * (double(k) - mean_k);
+  }
+  return 2.0 * sxy / sxx;
 }
 
 }  // namespace mpmvv::analytic

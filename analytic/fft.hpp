@@ -19,4 +19,12 @@ std::vector<double> amplitude_spectrum(const std::vector<double>& samples);
 // the error is a small fraction of a bin, 1 / duration).
 double dominant_frequency(const std::vector<double>& t, const std::vector<double>& value);
 
+// The period of a history that oscillates about zero, from its zero crossings
+// (linear interpolation between samples: for a sine the curvature vanishes at
+// a crossing, so the error is of third order in the sample spacing), fitted by
+// least squares as t_n = t_0 + n T / 2. `estimate` (from the spectrum) sets
+// which crossings count: those at least a quarter of it apart. NaN with fewer
+// than three crossings.
+double crossing_period(const std::vector<double>& t, const std::vector<double>& value, double estimate);
+
 }  // namespace mpmvv::analytic

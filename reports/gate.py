@@ -9,8 +9,11 @@ the error `norm` at output `time` (default: each case's end time) from /errors,
 and fit the least-squares order of ln E against ln h (reports/orders.py). The
 expectation holds for a series when
 
-* the fitted order lies in [order - tolerance, order + tolerance];
+* the fitted order lies in [order - tolerance, order + tolerance] (when an
+  order is given);
 * max over the levels of E / h^order <= max_error_constant (when given);
+* every usable level's E <= max_error (when given; an expectation gives an
+  order with its tolerance, or max_error, or both);
 * every level's case completed (when must_complete, the default);
 * at least two levels are usable (have a finite error at that time).
 
@@ -33,9 +36,9 @@ NUMBER = (int, float)
 EXPECT_KEYS = {
     "study": (str,), "norm": (str,), "order": NUMBER, "tolerance": NUMBER,
     "where": (dict,), "time": NUMBER, "refine": (str,), "levels": (list,),
-    "max_error_constant": NUMBER, "must_complete": (bool,),
+    "max_error_constant": NUMBER, "max_error": NUMBER, "must_complete": (bool,),
 }
-REQUIRED_KEYS = ("study", "norm", "order", "tolerance")
+REQUIRED_KEYS = ("study", "norm")
 
 
 @dataclass(frozen=True)
@@ -64,6 +67,11 @@ def validate_expectations(suite):
         for key in REQUIRED_KEYS:
             if key not in expect:
                 raise SuiteDirectoryError(f"{where}: [[expect]] {number}: '{key}' is required")
+        if "max_error" not in expect or "order" in expect or "tolerance" in expect:
+            for key in ("order", "tolerance"):
+                if key not in expect:
+                    raise SuiteDirectoryError(f"{where}: [[expect]] {number}: '{key}' is required"
+                                              + ("" if "max_error" in expect else " (or 'max_error' alone)"))
         for key, value in expect.items():
             if key not in EXPECT_KEYS:
                 raise SuiteDirectoryError(f"{where}: [[expect]] {number}: unknown key '{key}' "
@@ -72,8 +80,13 @@ def validate_expectations(suite):
                 raise SuiteDirectoryError(f"{where}: [[expect]] {number}: '{key}' has the wrong type ({value!r})")
         if expect["study"] not in studies:
             raise SuiteDirectoryError(f"{where}: [[expect]] {number}: no study named '{expect['study']}'")
-        if expect["tolerance"] < 0:
-            raise SuiteDirectoryError(f"{where}: [[expect]] {number}: 'tolerance' must be >= 0")
+        if "max_error" not in expect or "order" in expect or "tolerance" in expect:
+            if expect["tolerance"] < 0:
+                raise SuiteDirectoryError(f"{where}: [[expect]] {number}: 'tolerance' must be >= 0")
+        if "max_error" in expect and not expect["max_error"] > 0:
+            raise SuiteDirectoryError(f"{where}: [[expect]] {number}: 'max_error' must be positive")
+        if "max_error_constant" in expect and "order" not in expect:
+            raise SuiteDirectoryError(f"{where}: [[expect]] {number}: 'max_error_constant' needs an 'order'")
 
 
 def check_expectation(number, expect, suite):
@@ -96,14 +109,27 @@ def check_series(number, expect, series):
     levels = series_levels(series, expect["norm"], expect.get("time"), expect.get("levels"))
     good = usable(levels)
     fit = least_squares_order([l.h for l in good], [l.error for l in good])
-    order, tolerance = float(expect["order"]), float(expect["tolerance"])
-    constant = max((l.error / l.h ** order for l in good), default=float("nan"))
+    has_order = "order" in expect
+    order = float(expect["order"]) if has_order else float("nan")
+    tolerance = float(expect["tolerance"]) if has_order else float("nan")
+    constant = max((l.error / l.h ** order for l in good), default=float("nan")) if has_order else float("nan")
     reasons, notes = [], []
     if expect.get("must_complete", True):
         unfinished = [l for l in levels if l.case is None or not l.case.completed]
         if unfinished:
             reasons.append("not completed: " + "; ".join(_level_outcome(series, l) for l in unfinished))
-    if len(good) < 2:
+    bound = expect.get("max_error")
+    if bound is not None:
+        above = [l for l in good if not l.error <= bound]
+        if above:
+            reasons.append("error above " + f"{bound:g}: " + ", ".join(f"{series.refine}={l.value}: {l.error:.3g}"
+                                                                      for l in above))
+        if not good:
+            left_out = [f"{series.refine}={l.value}: {l.reason}" for l in levels if l.reason]
+            reasons.append("no usable level" + (f" ({'; '.join(left_out)})" if left_out else ""))
+    if not has_order:
+        pass
+    elif len(good) < 2:
         left_out = [f"{series.refine}={l.value}: {l.reason}" for l in levels if l.reason]
         reasons.append(f"{len(good)} usable level(s), need 2" + (f" ({'; '.join(left_out)})" if left_out else ""))
     elif not math.isfinite(fit.order):
@@ -118,7 +144,7 @@ def check_series(number, expect, series):
     limit = expect.get("max_error_constant")
     if limit is not None and math.isfinite(constant) and constant > limit:
         reasons.append(f"E/h^{order:g} = {constant:.3g} > {limit:g}")
-    if len(good) >= 2:
+    if len(good) >= (2 if has_order else 1):
         notes = [f"left out {series.refine}={l.value} ({l.reason})" for l in levels if l.reason]
     return Verdict(number, expect, series, tuple(levels), fit, constant, tuple(reasons), tuple(notes))
 
@@ -152,7 +178,6 @@ def _end_time_text(series):
 def verdict_row(verdict):
     """The table cells of one verdict."""
     expect = verdict.expectation
-    order, tolerance = float(expect["order"]), float(expect["tolerance"])
     fit = verdict.fit
     observed = "-" if not math.isfinite(fit.order) else f"{fit.order:.3f}"
     if math.isfinite(fit.ci_low):
@@ -162,6 +187,14 @@ def verdict_row(verdict):
     constant = "-" if not math.isfinite(verdict.error_constant) else f"{verdict.error_constant:.3g}"
     if limit is not None:
         constant += f" <= {limit:g}"
+    if "order" in expect:
+        expected = f"[{float(expect['order']) - float(expect['tolerance']):g}, " \
+                   f"{float(expect['order']) + float(expect['tolerance']):g}]"
+    else:
+        expected = "-"
+    if "max_error" in expect:
+        largest = max((l.error for l in verdict.levels if not l.reason), default=float("nan"))
+        constant = ("-" if not math.isfinite(largest) else f"E = {largest:.3g}") + f" <= {expect['max_error']:g}"
     return [
         str(verdict.number),
         expect["study"],
@@ -170,7 +203,7 @@ def verdict_row(verdict):
         f"{expect['time']:g}" if "time" in expect else _end_time_text(verdict.series),
         ",".join(used) or "-",
         observed,
-        f"[{order - tolerance:g}, {order + tolerance:g}]",
+        expected,
         constant,
         "PASS" if verdict.passed else "FAIL",
         "; ".join(verdict.reasons or verdict.notes),
@@ -178,7 +211,7 @@ def verdict_row(verdict):
 
 
 HEADER = ["#", "study", "series", "norm", "t", "levels", "observed order [95% CI]", "expected",
-          "E/h^p", "status", "reason"]
+          "E/h^p or E", "status", "reason"]
 
 
 def format_table(rows):

@@ -153,3 +153,39 @@ def test_manifest_status_is_kept_for_cases_without_results(synthetic_suite):
     assert crashed.status == "crashed" and crashed.failure_reason == "signal 11 (SIGSEGV)"
     manifest = json.loads((synthetic_suite / "manifest.json").read_text())
     assert len(manifest["cases"]) == len(cases)
+
+
+MAX_ERROR_SUITE = """description = "synthetic ring suite: a bound on the error itself"
+
+[[study]]
+name = "ring"
+scene = "scenes/ring.toml"
+sweep = { method = ["linear", "cpdi"], cells = [32, 64, 128, 256] }
+
+[[expect]]
+study = "ring"
+where = { method = "cpdi" }
+norm = "L1_theta0"
+levels = [32, 64, 128]
+max_error = 0.005
+
+[[expect]]
+study = "ring"
+where = { method = "cpdi" }
+norm = "L1_theta0"
+levels = [64, 128]
+max_error = 0.001
+"""
+
+
+def test_gate_checks_a_bound_on_the_error_itself(tmp_path, capsys):
+    """Requirement: `max_error` alone (no order) holds when every usable level's
+    error is at most the bound and fails naming the levels above it. The cpdi
+    errors are 0.5 h^2 at t = 1: 4.39e-3, 1.10e-3, 2.75e-4 on 32, 64, 128 cells."""
+    directory = write_suite_directory(tmp_path / "suite", MAX_ERROR_SUITE, synthetic_ring_cases())
+    status, out, _ = run_gate(directory, capsys)
+    assert status == 1
+    first, second = rows_of(out)
+    assert "PASS" in first and "E = 0.00439 <= 0.005" in first
+    assert "FAIL" in second and "error above 0.001: cells=64: 0.0011" in second
+    assert "1 of 2 expectations fell short" in out

@@ -39,13 +39,14 @@ namespace {
 template <class Shape, class Material>
 class ExplicitStepper final : public Stepper {
  public:
-  ExplicitStepper(Model model, Scheme scheme, Material material,
-                  std::shared_ptr<BodyForce> body_force, double gradient_scale)
+  ExplicitStepper(Model model, Scheme scheme, Material material, SceneStages stages, double gradient_scale)
       : Stepper(std::move(model)),
         scheme_(scheme),
         gradient_scale_(gradient_scale),
         material_(material),
-        body_force_(std::move(body_force)) {
+        body_force_(std::move(stages.body_force)),
+        constraints_(std::move(stages.constraints)),
+        damping_(stages.damping) {
     buffers_.resize(max_threads(), model_.grid.node_count());
     if (body_force_) {
       body_force_->prepare(model_.particles);
@@ -93,8 +94,7 @@ class ExplicitStepper final : public Stepper {
     Particles& P = model_.particles;
     const Shape shape = bind(P);
     map_mass_momentum_and_forces(shape, t);
-    update_grid_motion(fields_, kick);
-    apply_walls(model_.grid, fields_);
+    advance_grid(t, dt, kick);
     move_tracers(dt);
     grid_to_particles<kVelocity | kPosition | kDeformation, Shape>(shape, fields_, P, dt, kick);
     update_stress<Shape::geometry>(material_, P);
@@ -116,6 +116,7 @@ class ExplicitStepper final : public Stepper {
     particles_to_grid<kMass | kMomentum>(shape, P, buffers_, fields_);
     grid_velocity_from_momentum(fields_);
     apply_walls(model_.grid, fields_);
+    if (!constraints_.empty()) apply_constraints(constraints_, t, dt, kick, fields_);
     grid_to_particles<kDeformation, Shape>(shape, fields_, P, dt, kick);
     update_stress<Shape::geometry>(material_, P);
     if (body_force_) {
@@ -124,8 +125,7 @@ class ExplicitStepper final : public Stepper {
     } else {
       particles_to_grid<kInternalForce>(shape, P, buffers_, fields_);
     }
-    update_grid_motion(fields_, kick);
-    apply_walls(model_.grid, fields_);
+    advance_grid(t, dt, kick);
     move_tracers(dt);
     grid_to_particles<kVelocity | kPosition, Shape>(shape, fields_, P, dt, kick);
   }
@@ -136,13 +136,13 @@ class ExplicitStepper final : public Stepper {
     Particles& P = model_.particles;
     const Shape shape = bind(P);
     map_mass_momentum_and_forces(shape, t);
-    update_grid_motion(fields_, kick);
-    apply_walls(model_.grid, fields_);
+    advance_grid(t, dt, kick);
     move_tracers(dt);
     grid_to_particles<kVelocity | kPosition, Shape>(shape, fields_, P, dt, kick, next_position_.data());
     particles_to_grid<kMomentum>(shape, P, buffers_, fields_);
     grid_velocity_from_momentum(fields_);
     apply_walls(model_.grid, fields_);
+    if (!constraints_.empty()) apply_constraints(constraints_, t, dt, kick, fields_);
     grid_to_particles<kDeformation, Shape>(shape, fields_, P, dt, kick);
     P.position.swap(next_position_);
     update_stress<Shape::geometry>(material_, P);
@@ -162,6 +162,15 @@ class ExplicitStepper final : public Stepper {
     }
   }
 
+  // a_g and v_g^L from the node sums (eqs. 1.71-1.72), with the scene's damping
+  // (eq. 1.65), then the walls and the scene's prescribed node motion.
+  void advance_grid(double t, double dt, double kick) {
+    update_grid_motion(fields_, kick);
+    if (damping_ > 0.0) damp_grid_motion(fields_, damping_, kick);
+    apply_walls(model_.grid, fields_);
+    if (!constraints_.empty()) reactions_ = apply_constraints(constraints_, t, dt, kick, fields_);
+  }
+
   void evaluate_body_force(double t) {
     const auto start = std::chrono::steady_clock::now();
     body_force_->evaluate(t, model_.particles, model_.particles.body_force);
@@ -176,6 +185,8 @@ class ExplicitStepper final : public Stepper {
   double gradient_scale_;
   Material material_;
   std::shared_ptr<BodyForce> body_force_;
+  std::vector<NodeConstraint> constraints_;
+  double damping_;
   ScatterBuffers buffers_;
   std::vector<Vec2> next_position_;  // MUSL only: x_{n+1} while x_n still sets the weights
   std::vector<Mat2> step_start_deformation_;  // USF with CPDI only: F_n, which sets the domains
@@ -183,11 +194,11 @@ class ExplicitStepper final : public Stepper {
 
 template <class Shape>
 std::unique_ptr<Stepper> make_for_shape(Model model, const SolverOptions& o, const MaterialModel& material,
-                                        std::shared_ptr<BodyForce> body_force) {
+                                        SceneStages stages) {
   return std::visit(
       [&](const auto& m) -> std::unique_ptr<Stepper> {
         using Material = std::decay_t<decltype(m)>;
-        return std::make_unique<ExplicitStepper<Shape, Material>>(std::move(model), o.scheme, m, std::move(body_force),
+        return std::make_unique<ExplicitStepper<Shape, Material>>(std::move(model), o.scheme, m, std::move(stages),
                                                                  o.cpdi_gradient_scale);
       },
       material);
@@ -195,11 +206,11 @@ std::unique_ptr<Stepper> make_for_shape(Model model, const SolverOptions& o, con
 
 template <Geometry G>
 std::unique_ptr<Stepper> make_for_geometry(Model model, const SolverOptions& o, const MaterialModel& material,
-                                           std::shared_ptr<BodyForce> body_force) {
+                                           SceneStages stages) {
   switch (o.method) {
-    case Method::linear: return make_for_shape<LinearShapeT<G>>(std::move(model), o, material, std::move(body_force));
-    case Method::gimp: return make_for_shape<GimpShapeT<G>>(std::move(model), o, material, std::move(body_force));
-    case Method::cpdi: return make_for_shape<CpdiShapeT<G>>(std::move(model), o, material, std::move(body_force));
+    case Method::linear: return make_for_shape<LinearShapeT<G>>(std::move(model), o, material, std::move(stages));
+    case Method::gimp: return make_for_shape<GimpShapeT<G>>(std::move(model), o, material, std::move(stages));
+    case Method::cpdi: return make_for_shape<CpdiShapeT<G>>(std::move(model), o, material, std::move(stages));
   }
   throw std::logic_error("unknown method");
 }
@@ -209,7 +220,23 @@ std::unique_ptr<Stepper> make_for_geometry(Model model, const SolverOptions& o, 
 std::unique_ptr<Stepper> make_stepper(Model model, const SolverOptions& options,
                                       const MaterialModel& material,
                                       std::shared_ptr<BodyForce> body_force) {
+  SceneStages stages;
+  stages.body_force = std::move(body_force);
+  return make_stepper(std::move(model), options, material, std::move(stages));
+}
+
+std::unique_ptr<Stepper> make_stepper(Model model, const SolverOptions& options,
+                                      const MaterialModel& material, SceneStages stages) {
   const std::size_t n = model.particles.size();
+  if (!(stages.damping >= 0.0)) throw std::invalid_argument("damping must be zero or positive");
+  for (const NodeConstraint& c : stages.constraints) {
+    if (c.axis != 0 && c.axis != 1) throw std::invalid_argument("a node constraint's axis is 0 (x) or 1 (y)");
+    if (!c.displacement) throw std::invalid_argument("a node constraint needs its displacement u(t)");
+    for (std::size_t node : c.nodes)
+      if (node >= model.grid.node_count())
+        throw std::invalid_argument(fmt::format("a node constraint names node {}, beyond the grid's {} nodes", node,
+                                                model.grid.node_count()));
+  }
   if (n == 0) throw std::invalid_argument("the scene seeded no particles");
   if (options.method != Method::linear && model.particles.half_size.size() != n)
     throw std::invalid_argument(fmt::format("method {} needs a particle domain (half_size) for every particle",
@@ -223,9 +250,9 @@ std::unique_ptr<Stepper> make_stepper(Model model, const SolverOptions& options,
                                                 "particle {} is at r = {}", p, model.particles.position[p].x()));
     if (model.grid.wall_lower().x() != 0.0)
       throw std::invalid_argument("an axisymmetric grid has its left wall on the axis r = 0");
-    return make_for_geometry<Geometry::axisymmetric>(std::move(model), options, material, std::move(body_force));
+    return make_for_geometry<Geometry::axisymmetric>(std::move(model), options, material, std::move(stages));
   }
-  return make_for_geometry<Geometry::plane_strain>(std::move(model), options, material, std::move(body_force));
+  return make_for_geometry<Geometry::plane_strain>(std::move(model), options, material, std::move(stages));
 }
 
 }  // namespace mpmvv

@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 
+#include "boundary.hpp"
 #include "model.hpp"
 
 namespace mpmvv {
@@ -34,16 +35,23 @@ class Stepper {
   const GridFields& grid_fields() const { return fields_; }
   // Wall time spent evaluating the body force, apart from the solver's own.
   double forcing_seconds() const { return forcing_seconds_; }
+  // Per node constraint of the scene, its reaction in the last step
+  // (apply_constraints); empty without constraints.
+  const std::vector<double>& constraint_reactions() const { return reactions_; }
 
  protected:
   explicit Stepper(Model model) : model_(std::move(model)) { fields_.resize(model_.grid.node_count()); }
   Model model_;
   GridFields fields_;
   double forcing_seconds_ = 0.0;
+  std::vector<double> reactions_;
 };
 
 // Checks the particles carry what the method needs, then picks the stepper
 // instantiation for (method, material): the one dispatch.
+std::unique_ptr<Stepper> make_stepper(Model model, const SolverOptions& options,
+                                      const MaterialModel& material, SceneStages stages);
+// A scene whose only optional stage is a body force (or none).
 std::unique_ptr<Stepper> make_stepper(Model model, const SolverOptions& options,
                                       const MaterialModel& material,
                                       std::shared_ptr<BodyForce> body_force);

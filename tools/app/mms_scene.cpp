@@ -136,10 +136,14 @@ class MmsCase final : public SceneCase, private RunObserver {
       throw ConfigError(fmt::format("the body holds no particle centre at cells = {}: use more cells",
                                     config_.integer("cells")));
     seed_tracers(model.tracers);
-    std::shared_ptr<BodyForce> force = setup_.fast_body_force;
-    if (!force) force = std::make_shared<mms::DerivedBodyForce>(setup_.solution);
-    if (fault_ == Fault::no_body_force || setup_.force_free) force = nullptr;
-    stepper_ = make_stepper(std::move(model), options_, setup_.material, std::move(force));
+    SceneStages stages;
+    if (setup_.stages) stages = setup_.stages(model.particles, model.grid);
+    if (!setup_.force_free) {
+      stages.body_force = setup_.fast_body_force;
+      if (!stages.body_force) stages.body_force = std::make_shared<mms::DerivedBodyForce>(setup_.solution);
+      if (fault_ == Fault::no_body_force) stages.body_force = nullptr;
+    }
+    stepper_ = make_stepper(std::move(model), options_, setup_.material, std::move(stages));
     outcome_ = run_time_loop(*stepper_, loop_, *this, progress);
     return outcome_;
   }
@@ -147,11 +151,12 @@ class MmsCase final : public SceneCase, private RunObserver {
   double cell_size() const override { return setup_.grid.h; }
   Geometry geometry() const override { return setup_.geometry; }
   std::string body_force_kind() const override {
-    return setup_.force_free ? "none" : setup_.fast_body_force ? "closed form" : "derived";
+    if (setup_.force_free) return setup_.loading.empty() ? "none" : "none; " + setup_.loading;
+    return setup_.fast_body_force ? "closed form" : "derived";
   }
-  std::vector<std::pair<std::string, double>> measurements() const override {
-    if (!setup_.measure || point_simulated_.empty() || point_time_.size() < 8) return {};
-    return setup_.measure(point_time_, point_simulated_.front());
+  Measurements measurements() const override {
+    if (!setup_.measure || !stepper_) return {};
+    return setup_.measure(RunRecord{point_time_, point_simulated_, *stepper_});
   }
   std::string seeding() const override { return exact_seeding_ ? "exact" : "centre"; }
   double particle_volume() const override { return particle_volume_; }
@@ -369,6 +374,7 @@ class MmsCase final : public SceneCase, private RunObserver {
     errors_ = ErrorTable{};
     for (const ProbeLine& line : setup_.lines) errors_.add_column("L1_" + line.name);
     for (const char* name : {"particle_L1", "particle_L2", "particle_Linf"}) errors_.add_column(name);
+    for (const std::string& name : setup_.extra_error_names) errors_.add_column(name);
   }
 
   double value_at(ProbeQuantity q, const Vec2& x, const Vec2& X, double t) const {
@@ -437,6 +443,12 @@ class MmsCase final : public SceneCase, private RunObserver {
     errors_.columns[first].second.push_back(l1 / weight);
     errors_.columns[first + 1].second.push_back(std::sqrt(l2 / weight));
     errors_.columns[first + 2].second.push_back(linf);
+    if (!setup_.extra_error_names.empty()) {
+      const std::vector<double> extra = setup_.extra_errors(t, RunRecord{point_time_, point_simulated_, s});
+      if (extra.size() != setup_.extra_error_names.size())
+        throw std::logic_error("a problem's extra errors do not match their names");
+      for (std::size_t k = 0; k < extra.size(); ++k) errors_.columns[first + 3 + k].second.push_back(extra[k]);
+    }
   }
 
   Config config_;
@@ -469,10 +481,23 @@ MmsProblem axis_aligned_problem();
 MmsProblem expanding_ring_problem();
 MmsProblem rz_cylinder_problem();
 MmsProblem vibrating_bar_problem();
+MmsProblem uniaxial_tension_problem();
+MmsProblem uniaxial_compression_problem();
+MmsProblem shear_problem();
+#ifdef MPMVV_HAVE_SUNDIALS
+MmsProblem neo_hookean_bar_problem();
+#endif
 
 const std::vector<MmsProblem>& mms_problems() {
-  static const std::vector<MmsProblem> problems = {ring_problem(), axis_aligned_problem(), expanding_ring_problem(),
-                                                   rz_cylinder_problem(), vibrating_bar_problem()};
+  static const std::vector<MmsProblem> problems = [] {
+    std::vector<MmsProblem> p = {ring_problem(),          axis_aligned_problem(),        expanding_ring_problem(),
+                                 rz_cylinder_problem(),   vibrating_bar_problem(),       uniaxial_tension_problem(),
+                                 uniaxial_compression_problem(), shear_problem()};
+#ifdef MPMVV_HAVE_SUNDIALS
+    p.push_back(neo_hookean_bar_problem());  // its exact state is a root found by KINSOL
+#endif
+    return p;
+  }();
   return problems;
 }
 

@@ -5,12 +5,14 @@
 #pragma once
 
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "mms/exact_solution.hpp"
+#include "solver/boundary.hpp"
 #include "scene.hpp"
 #ifdef MPMVV_HAVE_CGAL
 #include "body.hpp"
@@ -51,7 +53,17 @@ struct ProbeCircle {
   int points;
 };
 
-// Everything particular to one manufactured problem.
+using Measurements = std::vector<std::pair<std::string, double>>;
+
+// What a problem's measurements read at the end of a run.
+struct RunRecord {
+  const std::vector<double>& point_time;                 // after every step
+  const std::vector<std::vector<double>>& point_values;  // per probe point, at those times
+  const Stepper& stepper;
+};
+
+// Everything particular to one problem: a manufactured solution under its
+// derived force, or a classical exact solution reached by boundary conditions.
 struct ProblemSetup {
   std::shared_ptr<const mms::ExactSolution> solution;
   MaterialModel material;
@@ -67,10 +79,22 @@ struct ProblemSetup {
   // A classical exact solution that needs no force: the body-force stage is
   // left out (the exact motion still gives the initial state and the errors).
   bool force_free = false;
-  // Scalars measured from the first probe point's history (time, value) at
-  // the end of a run, e.g. a period and an amplitude with their exact values.
-  std::function<std::vector<std::pair<std::string, double>>(const std::vector<double>&, const std::vector<double>&)>
-      measure;
+  // Boundary conditions and loads (solver/boundary.hpp), built once the
+  // particles are seeded (a traction names its particles); absent for the
+  // manufactured problems. `loading` says what they are, for the results file.
+  std::function<SceneStages(const Particles&, const GridGeometry&)> stages;
+  std::string loading;
+  // Error columns of the problem's own, computed at every output time from
+  // the run so far (the stepper's state, the probe points' histories), after
+  // the probe and particle norms.
+  std::vector<std::string> extra_error_names;
+  std::function<std::vector<double>(double t, const RunRecord&)> extra_errors;
+  // Scalars measured at the end of a run (name, value), e.g. a period from the
+  // first probe point's history, or the mean strain of the bar's middle.
+  std::function<Measurements(const RunRecord&)> measure;
+  // The motion is analytic in time before this (a load ramp is constant after
+  // it): `mms check` draws its times below it. Infinite: everywhere.
+  double smooth_until = std::numeric_limits<double>::infinity();
   // A closed form that equals the derived force (tests/test_manufactured.cpp
   // shows it), used instead of automatic differentiation for speed; absent
   // otherwise.

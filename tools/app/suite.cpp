@@ -357,7 +357,7 @@ Suite load_suite(const std::string& path) {
       const toml::table& e = *node.as_table();
       const std::string here = where_in(path, node);
       expect_only(e, {"study", "where", "norm", "time", "refine", "levels", "order", "tolerance", "max_error_constant",
-                      "must_complete"},
+                      "max_error", "must_complete"},
                   path, "[[expect]]");
       const toml::node* study = e.get("study");
       if (!study || !study->is_string()) throw ConfigError(fmt::format("{}: [[expect]] needs the study it checks", here));
@@ -370,13 +370,23 @@ Suite load_suite(const std::string& path) {
       if (const toml::node* w = e.get("where")) settings_of(table_at(*w, path, "where"), path, specs, name, "[[expect]] where");
       const toml::node* norm = e.get("norm");
       if (!norm || !norm->is_string()) throw ConfigError(fmt::format("{}: [[expect]] needs a norm (an /errors column, e.g. \"L1_theta0\")", here));
-      for (const char* k : {"order", "tolerance"}) {
-        const toml::node* n = e.get(k);
-        if (!n || !(n->is_integer() || n->is_floating_point()))
-          throw ConfigError(fmt::format("{}: [[expect]] needs '{}' (a number)", here, k));
+      // An order with its band, or a bound on the error itself (exact-solution
+      // scenes whose error sits at round-off or settling level), or both.
+      const toml::node* max_error = e.get("max_error");
+      if (max_error && !(max_error->value<double>().value_or(-1.0) > 0.0))
+        throw ConfigError(fmt::format("{}: [[expect]]: 'max_error' must be a positive number", where_in(path, *max_error)));
+      if (!max_error || e.get("order") || e.get("tolerance")) {
+        for (const char* k : {"order", "tolerance"}) {
+          const toml::node* n = e.get(k);
+          if (!n || !(n->is_integer() || n->is_floating_point()))
+            throw ConfigError(fmt::format("{}: [[expect]] needs '{}' (a number){}", here, k,
+                                          max_error ? "" : ", or 'max_error' alone"));
+        }
+        if (const toml::node* t = e.get("tolerance"); !(t->value<double>().value_or(-1.0) > 0.0))
+          throw ConfigError(fmt::format("{}: [[expect]]: 'tolerance' must be positive", where_in(path, *t)));
       }
-      if (const toml::node* t = e.get("tolerance"); !(t->value<double>().value_or(-1.0) > 0.0))
-        throw ConfigError(fmt::format("{}: [[expect]]: 'tolerance' must be positive", where_in(path, *t)));
+      if (e.get("max_error_constant") && !e.get("order"))
+        throw ConfigError(fmt::format("{}: [[expect]]: 'max_error_constant' needs an 'order'", here));
       if (const toml::node* m = e.get("max_error_constant"); m && !(m->value<double>().value_or(-1.0) > 0.0))
         throw ConfigError(fmt::format("{}: [[expect]]: 'max_error_constant' must be a positive number", where_in(path, *m)));
       if (const toml::node* t = e.get("time"); t && !(t->value<double>().value_or(-1.0) >= 0.0))

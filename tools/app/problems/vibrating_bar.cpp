@@ -68,20 +68,41 @@ ProblemSetup setup(const Config& c) {
   s.lines.push_back(std::move(line));
   s.points.push_back({"point_free_end", ProbeQuantity::displacement_x, Vec2(L, 0.5 * height)});
   const double V = motion.velocity_amplitude;
-  s.measure = [bar, V](const std::vector<double>& t, const std::vector<double>& u) {
+  // Period and amplitude of the free end's history so far: the spectrum's
+  // peak (FFTW) locates the period, the zero crossings measure it; NaN before
+  // the history spans a whole period (the period needs FFTW).
+  struct Vibration {
+    double amplitude, period, spectral_period;
+  };
+  const auto vibration = [bar](const RunRecord& r) {
+    const std::vector<double>& t = r.point_time;
+    const std::vector<double>& u = r.point_values.front();
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    if (t.size() < 8 || t.back() < bar.period(1)) return Vibration{nan, nan, nan};
     double amplitude = 0.0;
     for (double x : u) amplitude = std::max(amplitude, std::abs(x));
-    const double exact_amplitude = V / bar.frequency(1);
-    std::vector<std::pair<std::string, double>> m = {{"amplitude", amplitude},
-                                                     {"amplitude_exact", exact_amplitude},
-                                                     {"amplitude_error", amplitude / exact_amplitude - 1.0},
-                                                     {"period_exact", bar.period(1)}};
 #ifdef MPMVV_HAVE_FFTW
-    const double period = 1.0 / analytic::dominant_frequency(t, u);
-    m.push_back({"period", period});
-    m.push_back({"period_error", period / bar.period(1) - 1.0});
+    const double spectral = 1.0 / analytic::dominant_frequency(t, u);
+    return Vibration{amplitude, analytic::crossing_period(t, u, spectral), spectral};
+#else
+    return Vibration{amplitude, nan, nan};
 #endif
-    return m;
+  };
+  const double exact_amplitude = V / bar.frequency(1);
+  s.extra_error_names = {"error_period", "error_amplitude"};
+  s.extra_errors = [=](double, const RunRecord& r) {
+    const Vibration v = vibration(r);
+    return std::vector<double>{std::abs(v.period / bar.period(1) - 1.0), std::abs(v.amplitude / exact_amplitude - 1.0)};
+  };
+  s.measure = [=](const RunRecord& r) -> Measurements {
+    const Vibration v = vibration(r);
+    return {{"amplitude", v.amplitude},
+            {"amplitude_exact", exact_amplitude},
+            {"amplitude_error", v.amplitude / exact_amplitude - 1.0},
+            {"period", v.period},
+            {"period_exact", bar.period(1)},
+            {"period_error", v.period / bar.period(1) - 1.0},
+            {"period_spectral_peak", v.spectral_period}};
   };
   return s;
 }

@@ -1,0 +1,269 @@
+// Boundary conditions (solver/boundary.hpp) and the classical exact-solution
+// scenes built on them: prescribed node motion follows u(t) exactly and its
+// reaction balances the grid force; a traction puts its total force into the
+// body's momentum; damping takes energy out; the uniaxial bar, simple shear
+// and the neo-Hookean bar settle to their exact static states.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#ifdef MPMVV_HAVE_FFTW
+#include "analytic/fft.hpp"
+#endif
+#include "solver/boundary.hpp"
+#include "solver/explicit_stepper.hpp"
+#include "tools/app/scene.hpp"
+
+namespace {
+
+using mpmvv::GridFields;
+using mpmvv::GridGeometry;
+using mpmvv::Mat2;
+using mpmvv::Method;
+using mpmvv::Model;
+using mpmvv::NodeConstraint;
+using mpmvv::Particles;
+using mpmvv::SceneStages;
+using mpmvv::Scheme;
+using mpmvv::SolverOptions;
+using mpmvv::Vec2;
+
+// A square block of particles, 2 per cell per direction, at rest, away from
+// the walls of a 16 x 16 grid of unit cells.
+Model block(Method method) {
+  Model m;
+  m.grid = GridGeometry::walled(Vec2::Zero(), 1.0, 16, 16);
+  Particles& P = m.particles;
+  for (int j = 0; j < 8; ++j)
+    for (int i = 0; i < 8; ++i) {
+      const Vec2 X = Vec2(4.25 + 0.5 * i, 4.25 + 0.5 * j);
+      P.reference_position.push_back(X);
+    }
+  const std::size_t n = P.reference_position.size();
+  std::vector<Vec2> X = P.reference_position;
+  P.resize(n);
+  P.reference_position = X;
+  P.position = X;
+  for (std::size_t p = 0; p < n; ++p) {
+    P.reference_volume[p] = P.volume[p] = 0.25;
+    P.mass[p] = 1000.0 * 0.25;
+  }
+  if (method != Method::linear) P.half_size.assign(n, Vec2(0.25, 0.25));
+  return m;
+}
+
+const mpmvv::LinearElastic kSolid{2.0e6, 1.0e6};
+
+double kinetic_energy(const Particles& P) {
+  double e = 0.0;
+  for (std::size_t p = 0; p < P.size(); ++p) e += 0.5 * P.mass[p] * P.velocity[p].squaredNorm();
+  return e;
+}
+
+}  // namespace
+
+// apply_constraints sets the prescribed component to (u(t + dt) - u(t)) / dt,
+// leaves the other component alone, and returns sum (m a - f) over its nodes.
+TEST(Boundary, ConstraintSetsVelocityAndReturnsReaction) {
+  GridFields g;
+  g.resize(3);
+  for (int i = 0; i < 3; ++i) {
+    g.mass[i] = 2.0;
+    g.momentum[i] = Vec2(2.0, 4.0);  // velocity (1, 2) before the kick
+    g.force[i] = Vec2(6.0, 8.0);
+    g.velocity[i] = Vec2(7.0, 9.0);
+    g.acceleration[i] = Vec2(3.0, 4.0);
+  }
+  const std::vector<NodeConstraint> c = {{{0, 2}, 0, [](double t) { return 0.5 * t * t; }}};
+  const double t = 1.0, dt = 0.1, kick = 0.1;
+  const std::vector<double> reactions = mpmvv::apply_constraints(c, t, dt, kick, g);
+  const double v = (0.5 * 1.1 * 1.1 - 0.5) / dt;  // 1.05
+  for (int i : {0, 2}) {
+    EXPECT_DOUBLE_EQ(g.velocity[i].x(), v);
+    EXPECT_DOUBLE_EQ(g.acceleration[i].x(), (v - 1.0) / kick);
+    EXPECT_EQ(g.velocity[i].y(), 9.0);
+  }
+  EXPECT_EQ(g.velocity[1].x(), 7.0);
+  ASSERT_EQ(reactions.size(), 1u);
+  EXPECT_NEAR(reactions[0], 2.0 * (2.0 * (v - 1.0) / kick - 6.0), 1e-12);
+}
+
+// A block whose bottom row of nodes is driven along u_y(t) = 1e-3 sin(t):
+// after any number of steps of any size the particles that sit on those nodes'
+// row have moved by exactly u_y (linear shape functions interpolate the row).
+TEST(Boundary, ConstrainedNodesFollowTheirDisplacement) {
+  Model m = block(Method::linear);
+  std::vector<std::size_t> row;
+  for (int i = 0; i < m.grid.nodes_x(); ++i)
+    for (int j : {5, 6, 7, 8, 9, 10, 11, 12, 13})
+      row.push_back(std::size_t(m.grid.node(i, j)));
+  SceneStages stages;
+  auto u = [](double t) { return 1e-3 * std::sin(t); };
+  stages.constraints.push_back({row, 1, u});
+  auto stepper = mpmvv::make_stepper(std::move(m), SolverOptions{Method::linear, Scheme::usl}, kSolid, stages);
+  double t = 0.0;
+  for (double dt : {1e-3, 3e-3, 2e-3, 5e-4}) {
+    stepper->step(t, dt, dt);
+    t += dt;
+  }
+  const Particles& P = stepper->model().particles;
+  for (std::size_t p = 0; p < P.size(); ++p)
+    EXPECT_NEAR(P.position[p].y() - P.reference_position[p].y(), u(t), 1e-15) << p;
+}
+
+// With no other force a traction changes the body's momentum at its total
+// force: after the first step (a kick of dt), sum m v = F dt along its direction.
+TEST(Boundary, TractionDeliversItsTotalForce) {
+  for (Method method : {Method::linear, Method::gimp, Method::cpdi}) {
+    Model m = block(method);
+    std::vector<std::size_t> loaded;
+    std::vector<double> area;
+    for (std::size_t p = 0; p < m.particles.size(); ++p)
+      if (m.particles.reference_position[p].x() > 7.5) {
+        loaded.push_back(p);
+        area.push_back(0.5);
+      }
+    SceneStages stages;
+    auto traction = std::make_shared<mpmvv::SurfaceTraction>(loaded, area, Vec2(0.6, 0.8),
+                                                             [](double) { return 100.0; });
+    stages.body_force = traction;
+    auto stepper = mpmvv::make_stepper(std::move(m), SolverOptions{method, Scheme::usl}, kSolid, stages);
+    const double dt = 1e-4;
+    stepper->step(0.0, dt, dt);
+    Vec2 momentum = Vec2::Zero();
+    const Particles& P = stepper->model().particles;
+    for (std::size_t p = 0; p < P.size(); ++p) momentum += P.mass[p] * P.velocity[p];
+    const double F = traction->total_force(0.0);
+    EXPECT_DOUBLE_EQ(F, 100.0 * 0.5 * 8);
+    EXPECT_NEAR(momentum.x(), 0.6 * F * dt, 1e-12 * F * dt) << mpmvv::to_string(method);
+    EXPECT_NEAR(momentum.y(), 0.8 * F * dt, 1e-12 * F * dt) << mpmvv::to_string(method);
+  }
+}
+
+// Damping takes energy out: a free block started in a shearing motion (about
+// three periods of its lowest mode over the run) still swings with much of its
+// kinetic energy undamped and keeps almost none of it critically damped (the
+// largest kinetic energy over the last hundred steps, against the start).
+TEST(Boundary, DampingRemovesEnergy) {
+  double remaining[2];
+  for (int damped : {0, 1}) {
+    Model m = block(Method::cpdi);
+    for (std::size_t p = 0; p < m.particles.size(); ++p)
+      m.particles.velocity[p] = Vec2(0.01 * (m.particles.reference_position[p].y() - 6.0), 0.0);
+    const double start = kinetic_energy(m.particles);
+    SceneStages stages;
+    // c_s = sqrt(mu / rho) = 31.6 m/s over 4 m: omega about 25 /s.
+    stages.damping = damped ? 50.0 : 0.0;
+    auto stepper = mpmvv::make_stepper(std::move(m), SolverOptions{Method::cpdi, Scheme::usl}, kSolid, stages);
+    const double dt = 0.2 * 0.5 / 55.0;
+    double late = 0.0;
+    for (int k = 0; k < 400; ++k) {
+      stepper->step(k * dt, dt, dt);
+      if (k >= 300) late = std::max(late, kinetic_energy(stepper->model().particles));
+    }
+    remaining[damped] = late / start;
+  }
+  EXPECT_LT(remaining[1], 1e-3) << remaining[1];
+  EXPECT_GT(remaining[0], 0.2) << remaining[0];
+}
+
+#ifdef MPMVV_HAVE_FFTW
+// The period of a sampled sine from its zero crossings, located by the
+// spectrum: exact to far below the sample spacing.
+TEST(Boundary, CrossingPeriodOfASine) {
+  std::vector<double> t, u;
+  const double period = 0.37;
+  for (int i = 0; i <= 2000; ++i) {
+    t.push_back(2.0 * i / 2000.0);
+    u.push_back(std::sin(2.0 * M_PI * t.back() / period + 0.3));
+  }
+  const double estimate = 1.0 / mpmvv::analytic::dominant_frequency(t, u);
+  EXPECT_NEAR(estimate / period, 1.0, 2e-2);
+  EXPECT_NEAR(mpmvv::analytic::crossing_period(t, u, estimate) / period, 1.0, 1e-7);
+}
+#endif
+
+namespace {
+
+struct SceneRun {
+  mpmvv::app::ErrorTable errors;
+  std::vector<std::pair<std::string, double>> measurements;
+  bool completed;
+};
+
+SceneRun run_scene(const std::string& scene, const std::vector<std::string>& overrides) {
+  mpmvv::app::Config config(scene, mpmvv::app::find_scene_type(scene)->keys());
+  for (const std::string& o : overrides) config.set_from_text(o);
+  auto s = mpmvv::app::find_scene_type(scene)->build(config);
+  const mpmvv::RunOutcome outcome = s->run({});
+  return {s->errors(), s->measurements(), outcome.completed};
+}
+
+double measurement(const SceneRun& r, const std::string& name) {
+  for (const auto& [n, v] : r.measurements)
+    if (n == name) return v;
+  ADD_FAILURE() << "no measurement " << name;
+  return NAN;
+}
+
+}  // namespace
+
+// The seed's steel bar pulled and pushed 0.8566 um (22 cells, the defaults):
+// measured axial stress and lateral strain errors 7.6e-7 and 4.0e-7 (tension,
+// CPDI), 1.4e-5 (linear MPM), 3.3e-5 (compression); the seed reached 13 % on
+// Poisson's ratio. Bound: 1e-4 on both, and on the implied Poisson's ratio.
+TEST(ExactScenes, UniaxialBarMatchesHookesLaw) {
+  for (const char* scene : {"uniaxial-tension", "uniaxial-compression"})
+    for (const char* method : {"linear", "cpdi"}) {
+      const SceneRun r = run_scene(scene, {std::string("method=") + method});
+      ASSERT_TRUE(r.completed) << scene << " " << method;
+      EXPECT_LT(r.errors.column("error_axial_stress").back(), 1e-4) << scene << " " << method;
+      EXPECT_LT(r.errors.column("error_lateral_strain").back(), 1e-4) << scene << " " << method;
+      EXPECT_LT(r.errors.column("error_grip_stress").back(), 1e-4) << scene << " " << method;
+      EXPECT_NEAR(measurement(r, "poisson_ratio"), 0.3, 3e-5) << scene << " " << method;
+    }
+}
+
+// Simple shear of the seed's block (8 cells across): measured error of the
+// middle's shear stress 6e-8 (the seed: 1.9 %); bound 1e-5. The normal
+// stresses there vanish to the same measure.
+TEST(ExactScenes, ShearMatchesGGamma) {
+  const SceneRun r = run_scene("shear", {});
+  ASSERT_TRUE(r.completed);
+  EXPECT_LT(r.errors.column("error_shear_stress").back(), 1e-5);
+  EXPECT_LT(r.errors.column("error_normal_stress").back(), 1e-5);
+  EXPECT_NEAR(measurement(r, "shear_stress") / 15.5992e6, 1.0, 1e-5);
+}
+
+#ifdef MPMVV_HAVE_SUNDIALS
+// The neo-Hookean bar at 50 % stretch under its exact dead load, CPDI, 32
+// cells: measured errors of the lateral stretch and the axial stress 1.6e-4
+// and 2.2e-4 (16 cells: 6.9e-4, 8.5e-4; 64 cells: 3.3e-5, 5.7e-5). Bound 5e-4.
+TEST(ExactScenes, NeoHookeanBarReachesItsStretch) {
+  const SceneRun r = run_scene("neo-hookean-bar", {"cells=32"});
+  ASSERT_TRUE(r.completed);
+  EXPECT_LT(r.errors.column("error_lateral_stretch").back(), 5e-4);
+  EXPECT_LT(r.errors.column("error_axial_stress").back(), 5e-4);
+  EXPECT_NEAR(measurement(r, "axial_stretch"), 1.5, 5e-4);
+}
+#endif
+
+#ifdef MPMVV_HAVE_FFTW
+// The fixed-free bar in its first mode, CPDI: the period error falls at second
+// order with h (measured 1.28e-3, 3.15e-4, 7.83e-5 on 16, 32, 64 cells).
+TEST(ExactScenes, VibratingBarPeriodConvergesAtSecondOrder) {
+  std::vector<double> error;
+  for (int cells : {16, 32, 64}) {
+    const SceneRun r = run_scene("vibrating-bar", {"cells=" + std::to_string(cells)});
+    ASSERT_TRUE(r.completed);
+    error.push_back(r.errors.column("error_period").back());
+  }
+  for (int k = 0; k < 2; ++k) {
+    const double order = std::log2(error[k] / error[k + 1]);
+    EXPECT_GT(order, 1.8) << error[k] << " " << error[k + 1];
+    EXPECT_LT(order, 2.2) << error[k] << " " << error[k + 1];
+  }
+}
+#endif

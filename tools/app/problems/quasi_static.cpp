@@ -1,0 +1,108 @@
+#include "quasi_static.hpp"
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include <fmt/format.h>
+
+#include "tools/app/mms_scene.hpp"
+
+namespace mpmvv::app {
+
+std::vector<KeySpec> static_scene_keys(std::vector<KeySpec> k, const std::vector<KeySpec>& own,
+                                       const std::vector<KeySpec>& material) {
+  const double inf = std::numeric_limits<double>::infinity();
+  k.insert(k.end(), own.begin(), own.end());
+  const std::vector<KeySpec> load = {
+      {"ramp_periods", KeyKind::real, 4.0,
+       "the load rises over this many periods of the body's lowest mode, (1 - cos(pi t / T)) / 2, then holds", 0.0,
+       inf, true},
+      {"damping_ratio", KeyKind::real, 1.0,
+       "grid damping (eq. 1.65, zeta = ratio x 2 omega_1; 1 damps the lowest mode critically, 0: none)", 0.0, 100.0},
+  };
+  k.insert(k.end(), load.begin(), load.end());
+  k.push_back(seeding_key());
+  k.insert(k.end(), material.begin(), material.end());
+  return k;
+}
+
+void add_bar_probes(ProblemSetup& s, double L, double half, int points) {
+  ProbeLine line{"line_axis", ProbeQuantity::displacement_x, "reference_x", {}, {}, std::nullopt};
+  line.reference = points_on_segment(Vec2(0.0, 0.5 * half), Vec2(L, 0.5 * half), points);
+  for (const Vec2& X : line.reference) line.parameter.push_back(X.x());
+  s.lines.push_back(std::move(line));
+  s.points.push_back({"point_top_middle", ProbeQuantity::displacement_y, Vec2(0.5 * L, half)});
+}
+
+QuasiStatic quasi_static_from(const Config& c, double omega) {
+  const double period = 2.0 * std::numbers::pi / omega;
+  const double ramp_time = c.real("ramp_periods") * period;
+  if (c.real("end_time") < 1.5 * ramp_time)
+    c.reject("end_time", fmt::format("leaves no time to settle: the ramp lasts {:.6g} s ({} periods of {:.6g} s); "
+                                     "use at least {:.6g} s",
+                                     ramp_time, c.real("ramp_periods"), period, 1.5 * ramp_time));
+  return {ramp_time, c.real("damping_ratio") * 2.0 * omega};
+}
+
+namespace {
+
+int node_index(double offset, double h, const char* what) {
+  const double index = offset / h;
+  if (std::abs(index - std::round(index)) > 1e-9)
+    throw std::logic_error(fmt::format("the {} at {} is not a node line (h = {})", what, offset, h));
+  return int(std::lround(index));
+}
+
+}  // namespace
+
+std::vector<std::size_t> node_column(const GridGeometry& grid, double x) {
+  const int i = node_index(x - grid.origin.x(), grid.h, "column");
+  std::vector<std::size_t> nodes;
+  for (int j = 0; j < grid.nodes_y(); ++j) nodes.push_back(std::size_t(grid.node(i, j)));
+  return nodes;
+}
+
+std::vector<std::size_t> node_row(const GridGeometry& grid, double y) {
+  const int j = node_index(y - grid.origin.y(), grid.h, "row");
+  std::vector<std::size_t> nodes;
+  for (int i = 0; i < grid.nodes_x(); ++i) nodes.push_back(std::size_t(grid.node(i, j)));
+  return nodes;
+}
+
+RegionMeans region_means(const Particles& P, const std::function<bool(const Vec2&)>& in_region) {
+  RegionMeans m;
+  double weight = 0.0;
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    if (!in_region(P.reference_position[p])) continue;
+    const double w = P.reference_volume[p];
+    m.deformation_gradient += w * P.deformation_gradient[p];
+    m.stress += w * P.stress[p];
+    weight += w;
+    ++m.particles;
+  }
+  if (weight > 0.0) {
+    m.deformation_gradient /= weight;
+    m.stress /= weight;
+  }
+  return m;
+}
+
+Lame small_strain_lame(const MaterialModel& m) {
+  return std::visit(
+      [](const auto& x) -> Lame {
+        if constexpr (requires { x.lambda; }) {
+          return {x.lambda, x.mu};
+        } else {
+          const double mu = x.shear_modulus();
+          return {x.bulk_modulus - 2.0 / 3.0 * mu, mu};
+        }
+      },
+      m);
+}
+
+double relative_error(double measured, double exact) {
+  return exact != 0.0 ? std::abs(measured / exact - 1.0) : std::abs(measured);
+}
+
+}  // namespace mpmvv::app
