@@ -8,8 +8,10 @@
 #include <cstddef>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <vector>
 
+#include "contact.hpp"
 #include "grid.hpp"
 #include "model.hpp"
 #include "particles.hpp"
@@ -116,6 +118,7 @@ struct SceneStages {
   std::shared_ptr<BodyForce> body_force;    // a body force, or tractions on boundary particles
   std::vector<NodeConstraint> constraints;  // prescribed motion of grid nodes
   double damping = 0.0;                     // zeta of eq. 1.65 [1/s]; 0: no damping
+  std::optional<RigidBody> contact;         // a rigid master in frictionless contact (contact.hpp)
 };
 
 }  // namespace mpmvv

@@ -46,7 +46,8 @@ class ExplicitStepper final : public Stepper {
         material_(material),
         body_force_(std::move(stages.body_force)),
         constraints_(std::move(stages.constraints)),
-        damping_(stages.damping) {
+        damping_(stages.damping),
+        contact_(std::move(stages.contact)) {
     buffers_.resize(max_threads(), model_.grid.node_count());
     if (body_force_) {
       body_force_->prepare(model_.particles);
@@ -94,7 +95,7 @@ class ExplicitStepper final : public Stepper {
     Particles& P = model_.particles;
     const Shape shape = bind(P);
     map_mass_momentum_and_forces(shape, t);
-    advance_grid(t, dt, kick);
+    advance_grid(shape, t, dt, kick);
     move_tracers(dt);
     grid_to_particles<kVelocity | kPosition | kDeformation, Shape>(shape, fields_, P, dt, kick);
     update_stress<Shape::geometry>(material_, P);
@@ -125,7 +126,7 @@ class ExplicitStepper final : public Stepper {
     } else {
       particles_to_grid<kInternalForce>(shape, P, buffers_, fields_);
     }
-    advance_grid(t, dt, kick);
+    advance_grid(shape, t, dt, kick);
     move_tracers(dt);
     grid_to_particles<kVelocity | kPosition, Shape>(shape, fields_, P, dt, kick);
   }
@@ -136,7 +137,7 @@ class ExplicitStepper final : public Stepper {
     Particles& P = model_.particles;
     const Shape shape = bind(P);
     map_mass_momentum_and_forces(shape, t);
-    advance_grid(t, dt, kick);
+    advance_grid(shape, t, dt, kick);
     move_tracers(dt);
     grid_to_particles<kVelocity | kPosition, Shape>(shape, fields_, P, dt, kick, next_position_.data());
     particles_to_grid<kMomentum>(shape, P, buffers_, fields_);
@@ -163,12 +164,17 @@ class ExplicitStepper final : public Stepper {
   }
 
   // a_g and v_g^L from the node sums (eqs. 1.71-1.72), with the scene's damping
-  // (eq. 1.65), then the walls and the scene's prescribed node motion.
-  void advance_grid(double t, double dt, double kick) {
+  // (eq. 1.65), then the walls, the scene's prescribed node motion and its
+  // contact. (The velocity-only passes of USF and MUSL see contact through
+  // the particle velocities it has corrected.)
+  void advance_grid(const Shape& shape, double t, double dt, double kick) {
     update_grid_motion(fields_, kick);
     if (damping_ > 0.0) damp_grid_motion(fields_, damping_, kick);
     apply_walls(model_.grid, fields_);
     if (!constraints_.empty()) reactions_ = apply_constraints(constraints_, t, dt, kick, fields_);
+    if (contact_)
+      apply_rigid_contact(*contact_, shape, model_.particles, model_.grid, fields_, t, dt, kick, contact_scratch_,
+                          contact_forces_);
   }
 
   void evaluate_body_force(double t) {
@@ -187,6 +193,8 @@ class ExplicitStepper final : public Stepper {
   std::shared_ptr<BodyForce> body_force_;
   std::vector<NodeConstraint> constraints_;
   double damping_;
+  std::optional<RigidBody> contact_;
+  ContactScratch contact_scratch_;
   ScatterBuffers buffers_;
   std::vector<Vec2> next_position_;  // MUSL only: x_{n+1} while x_n still sets the weights
   std::vector<Mat2> step_start_deformation_;  // USF with CPDI only: F_n, which sets the domains
@@ -229,6 +237,8 @@ std::unique_ptr<Stepper> make_stepper(Model model, const SolverOptions& options,
                                       const MaterialModel& material, SceneStages stages) {
   const std::size_t n = model.particles.size();
   if (!(stages.damping >= 0.0)) throw std::invalid_argument("damping must be zero or positive");
+  if (stages.contact && !stages.contact->displacement)
+    throw std::invalid_argument("a contact master needs its displacement d(t)");
   for (const NodeConstraint& c : stages.constraints) {
     if (c.axis != 0 && c.axis != 1) throw std::invalid_argument("a node constraint's axis is 0 (x) or 1 (y)");
     if (!c.displacement) throw std::invalid_argument("a node constraint needs its displacement u(t)");

@@ -38,6 +38,9 @@ class Stepper {
   // Per node constraint of the scene, its reaction in the last step
   // (apply_constraints); empty without constraints.
   const std::vector<double>& constraint_reactions() const { return reactions_; }
+  // With a contact master, the contact force of the last step at each node;
+  // empty without one.
+  const ContactForces& contact_forces() const { return contact_forces_; }
 
  protected:
   explicit Stepper(Model model) : model_(std::move(model)) { fields_.resize(model_.grid.node_count()); }
@@ -45,6 +48,7 @@ class Stepper {
   GridFields fields_;
   double forcing_seconds_ = 0.0;
   std::vector<double> reactions_;
+  ContactForces contact_forces_;
 };
 
 // Checks the particles carry what the method needs, then picks the stepper

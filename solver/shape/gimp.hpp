@@ -127,6 +127,14 @@ struct GimpShapeT {
 
   // The particle's centre lies between the walls and its domain inside the
   // grid (ghost layers included).
+  // The domain's half-vectors as columns: the undeformed square (uGIMP).
+  Mat2 domain(std::size_t p) const {
+    Mat2 s = Mat2::Zero();
+    s(0, 0) = half_size[p].x();
+    s(1, 1) = half_size[p].y();
+    return s;
+  }
+
   bool inside(std::size_t p) const {
     const Vec2 lo = position[p] - half_size[p], hi = position[p] + half_size[p];
     const Vec2 top = grid->upper();

@@ -82,6 +82,9 @@ struct LinearShapeT {
       if (!(position[p].x() > 0.0)) return false;
     return inside_walls(*grid, position[p]);
   }
+
+  // A material point has no domain: its half-vectors are zero.
+  Mat2 domain(std::size_t) const { return Mat2::Zero(); }
 };
 
 using LinearShape = LinearShapeT<Geometry::plane_strain>;

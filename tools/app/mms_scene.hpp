@@ -92,6 +92,15 @@ struct ProblemSetup {
   // Scalars measured at the end of a run (name, value), e.g. a period from the
   // first probe point's history, or the mean strain of the bar's middle.
   std::function<Measurements(const RunRecord&)> measure;
+  // False when the problem's exact solution is not a motion of the body (Hertz
+  // contact): the particle displacement norms are left out of /errors.
+  bool exact_motion = true;
+  // Scalars recorded after every step (e.g. load and approach), written under
+  // /probes/history with the time.
+  std::vector<std::string> history_names;
+  std::function<std::vector<double>(double t, const Stepper&)> history;
+  // Writes what the problem gathered itself under /probes (e.g. pressure profiles).
+  std::function<void(h5::Group& probes)> write_extra;
   // The motion is analytic in time before this (a load ramp is constant after
   // it): `mms check` draws its times below it. Infinite: everywhere.
   double smooth_until = std::numeric_limits<double>::infinity();

@@ -1,0 +1,111 @@
+// Frictionless contact of the scene's body with a rigid body of exact shape
+// moved by a prescribed translation: the master of specified-velocity contact
+// (002_c3305cb8b1bc1490.txt section 1.7.4, eq. 1.110), whose velocity the
+// grid nodes in contact take along the master's normal, while their tangential
+// velocity is left free. Contact is decided from the exact geometry, not from
+// shared grid mass (which would see contact a cell early): a node is in
+// contact when the domain of a particle it carries would cross the master's
+// surface during the step, and its normal velocity is then limited to closing
+// exactly the remaining gap (eq. 1.112's "approaching" condition with the
+// gap as the measure). The grid force this takes is the contact force.
+#pragma once
+
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <vector>
+
+#include "grid.hpp"
+#include "particles.hpp"
+#include "shape/stencil.hpp"
+
+namespace mpmvv {
+
+struct RigidBody {
+  enum class Kind { disk, half_plane };
+  Kind kind = Kind::disk;
+  Vec2 point = Vec2::Zero();   // disk: the centre; half-plane: a point of its surface (at t = 0)
+  double radius = 0.0;         // disk
+  Vec2 outward = Vec2(0, 1);   // half-plane: unit normal pointing out of the rigid body
+  std::function<Vec2(double)> displacement;  // of the body, d(0) = 0 [m]
+
+  // Signed distance of x from the surface at time t: negative inside the body.
+  double distance(const Vec2& x, double t) const {
+    const Vec2 p = point + displacement(t);
+    return kind == Kind::disk ? (x - p).norm() - radius : (x - p).dot(outward);
+  }
+  // The outward unit normal of the surface nearest x.
+  Vec2 normal(const Vec2& x, double t) const {
+    if (kind == Kind::half_plane) return outward;
+    const Vec2 r = x - (point + displacement(t));
+    const double n = r.norm();
+    return n > 0.0 ? Vec2(r / n) : Vec2(0.0, 1.0);
+  }
+};
+
+// The contact force on the scene's body at each grid node of the last step
+// (zero where there was none) [N per unit depth], and its sum.
+struct ContactForces {
+  std::vector<Vec2> node_force;
+  Vec2 total = Vec2::Zero();
+};
+
+// Work arrays of the contact stage, allocated once per run.
+struct ContactScratch {
+  std::vector<double> particle_gap;  // signed distance of each particle's domain from the master
+  std::vector<double> node_gap;      // the smallest over the particles each node carries
+};
+
+// After the grid update (velocities at the end of the kick): limits the normal
+// velocity of the nodes in contact, v_g.n >= V.n - gap_g / dt, with V the
+// master's velocity over the step and n its outward normal at the node, and
+// books the force m_g dv / kick.
+template <class Shape>
+void apply_rigid_contact(const RigidBody& master, const Shape& shape, const Particles& P, const GridGeometry& grid,
+                         GridFields& g, double t, double dt, double kick, ContactScratch& scratch,
+                         ContactForces& out) {
+  const std::size_t n = P.size();
+  const std::size_t nodes = g.mass.size();
+  scratch.particle_gap.resize(n);
+  scratch.node_gap.assign(nodes, std::numeric_limits<double>::infinity());
+  out.node_force.assign(nodes, Vec2::Zero());
+  out.total.setZero();
+  const Vec2 V = (master.displacement(t + dt) - master.displacement(t)) / dt;
+  // A particle farther than this cannot reach the master in one step (a step
+  // moves less than a cell).
+  const double reach = 2.0 * grid.h + V.norm() * dt;
+
+  // The domain's nearest point to the master: the corner deepest along the
+  // master's normal (a parallelogram's extreme along a direction is a corner).
+#pragma omp parallel for schedule(static)
+  for (std::size_t p = 0; p < n; ++p) {
+    const Mat2 s = shape.domain(p);
+    double gap = std::numeric_limits<double>::infinity();
+    for (const double a : {-1.0, 1.0})
+      for (const double b : {-1.0, 1.0})
+        gap = std::min(gap, master.distance(P.position[p] + a * s.col(0) + b * s.col(1), t));
+    scratch.particle_gap[p] = gap;
+  }
+  Stencil<Shape::stencil_size> st;
+  for (std::size_t p = 0; p < n; ++p) {
+    if (scratch.particle_gap[p] > reach) continue;
+    shape.evaluate(p, st);
+    for (int k = 0; k < Shape::stencil_size; ++k)
+      if (st.weight[k] > 0.0) scratch.node_gap[st.node[k]] = std::min(scratch.node_gap[st.node[k]], scratch.particle_gap[p]);
+  }
+  for (std::size_t i = 0; i < nodes; ++i) {
+    if (!(g.mass[i] > 0.0) || !std::isfinite(scratch.node_gap[i])) continue;
+    const int ix = int(i % std::size_t(grid.nodes_x())), iy = int(i / std::size_t(grid.nodes_x()));
+    const Vec2 normal = master.normal(grid.node_position(ix, iy), t);
+    const double closing = (g.velocity[i] - V).dot(normal);  // negative: approaching
+    const double limit = -scratch.node_gap[i] / dt;
+    if (closing >= limit) continue;
+    const Vec2 dv = (limit - closing) * normal;
+    g.velocity[i] += dv;
+    g.acceleration[i] += dv / kick;
+    out.node_force[i] = g.mass[i] * dv / kick;
+    out.total += out.node_force[i];
+  }
+}
+
+}  // namespace mpmvv

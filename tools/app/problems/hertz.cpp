@@ -1,0 +1,224 @@
+// Hertz contact of a rigid cylinder on an elastic plate in plane strain
+// (PROBLEMS.md section 4; K. L. Johnson, Contact Mechanics; the setup of
+// 004_5b499dc27e377c32.txt section 4.3: a rigid disk of radius 2 m pressed
+// into a steel plate, E = 207 GPa, nu = 0.3, bottom fixed). No forcing. The
+// disk is a rigid master moved down by the approach along the ramp of
+// analytic/quasi_static.hpp, in frictionless contact with the plate through
+// the grid (solver/contact.hpp); damping settles the plate. The scene holds
+// the half x >= 0 (the wall x = 0 is the plane of symmetry); the plate
+// [0, W] x [-D, 0] is clamped at its bottom and free at its far side.
+//
+// In plane strain the approach is not fixed by half-space theory, so the
+// comparison is at the load the run measures, P = 2 sum of the vertical contact
+// force: a = sqrt(4 P R / (pi E*)), p0 = 2 P / (pi a), E* = E / (1 - nu^2)
+// (analytic/hertz.hpp). The half-width is read from the moments of the node
+// columns' contact forces, a^2 = 4 int x^2 p / int p (exact for
+// p0 sqrt(1 - x^2 / a^2)), the pressure per cell and the peak from the cells
+// beside the axis (read_contact). A finite
+// plate departs from the half-space by terms in (a / D)^2: the default plate
+// is ten half-widths deep, and `plate_depth` takes it deeper.
+#include <cmath>
+#include <memory>
+#include <numbers>
+
+#include <fmt/format.h>
+
+#include "analytic/hertz.hpp"
+#include "analytic/quasi_static.hpp"
+#include "tools/app/mms_scene.hpp"
+#include "tools/app/problems/quasi_static.hpp"
+
+namespace mpmvv::app {
+
+namespace {
+
+std::vector<KeySpec> keys() {
+  const double inf = std::numeric_limits<double>::infinity();
+  // The plate's lowest mode (shear through its depth, clamped below) has a
+  // period of 4 D / c_s = 2.5e-4 s; four periods of ramp, four to settle.
+  std::vector<KeySpec> k = solver_keys(50, 2e-3, {2e-3});
+  for (KeySpec& spec : k)
+    if (spec.name == "cells") spec.help = "cells across the plate's depth";
+  const std::vector<KeySpec> own = {
+      {"radius", KeyKind::real, 2.0, "R, the rigid disk's radius [m] (the seed's 2 m)", 0.0, inf, true},
+      {"approach", KeyKind::real, 2e-4, "delta, how far the disk moves into the plate [m]", 0.0, inf, true},
+      {"plate_depth", KeyKind::real, 0.2, "D, the plate's depth below its surface [m]", 0.0, inf, true},
+      {"plate_width", KeyKind::real, 0.2, "W, the plate's half-width beside the axis [m]", 0.0, inf, true},
+  };
+  return static_scene_keys(std::move(k), own,
+                           material_keys("linear-elastic", 1.194230769e11, 7.96153846e10, 7850.0));
+}
+
+// The vertical contact force of each node column x_i >= 0 (positive pressing
+// into the plate), the pressure it gives and what Hertz theory says at the
+// load it sums to. Nodal contact forces alternate from column to column (the
+// checkerboard of a node-wise constraint); the pressure is read per cell, half
+// of each bounding column's force over the cell's width, which removes the
+// alternation and, for a smooth profile, changes it by O(h^2):
+//   p(h/2) = (F_0 + F_1 / 2) / h   (F_0 is the half model's share of the axis column),
+//   p((i + 1/2) h) = (F_i + F_{i+1}) / (2 h).
+// The peak on the axis comes from the two cells beside it, with p even in x:
+// p0 = (9 p(h/2) - p(3h/2)) / 8.
+struct ContactReading {
+  std::vector<double> x, pressure, exact_pressure;  // at cell midpoints
+  double load = 0.0;            // P, both halves [N/m]
+  double half_width = 0.0;      // from the moments
+  double extent = 0.0;          // the farthest column that carries force
+  double peak_pressure = 0.0;   // on the axis
+  analytic::HertzCylinder hertz{0.0, 0.0, 1.0};
+};
+
+ContactReading read_contact(const GridGeometry& grid, const ContactForces& contact, double radius,
+                            double contact_modulus) {
+  ContactReading r;
+  const int nx = grid.nodes_x(), ny = grid.nodes_y();
+  const int axis = grid.ghost_layers;  // the wall x = 0
+  std::vector<double> column;
+  double half_load = 0.0, second_moment = 0.0;
+  for (int i = axis; i < nx; ++i) {
+    double force = 0.0;
+    if (!contact.node_force.empty())
+      for (int j = 0; j < ny; ++j) force -= contact.node_force[std::size_t(grid.node(i, j))].y();
+    const double x = grid.node_position(i, 0).x();
+    column.push_back(force);
+    half_load += force;
+    second_moment += force * x * x;
+    if (force > 0.0) r.extent = x;
+  }
+  const double h = grid.h;
+  for (std::size_t i = 0; i + 1 < column.size(); ++i) {
+    r.x.push_back((double(i) + 0.5) * h);
+    r.pressure.push_back(i == 0 ? (column[0] + 0.5 * column[1]) / h : 0.5 * (column[i] + column[i + 1]) / h);
+  }
+  r.load = 2.0 * half_load;
+  r.half_width = half_load > 0.0 ? std::sqrt(4.0 * second_moment / half_load) : 0.0;
+  r.peak_pressure = r.pressure.size() > 1 ? (9.0 * r.pressure[0] - r.pressure[1]) / 8.0 : 0.0;
+  r.hertz = analytic::HertzCylinder{std::max(r.load, 0.0), radius, contact_modulus};
+  for (double x : r.x) r.exact_pressure.push_back(r.load > 0.0 ? r.hertz.pressure(x) : 0.0);
+  return r;
+}
+
+// The pressure profiles at the output times and the load-approach history,
+// gathered during the run and written with the results.
+struct HertzRecord {
+  std::vector<double> x;
+  std::vector<double> time;
+  std::vector<std::vector<double>> pressure, exact_pressure;
+};
+
+ProblemSetup setup(const Config& c) {
+  ProblemSetup s;
+  s.material = material_from(c);
+  if (!std::holds_alternative<LinearElastic>(s.material))
+    c.reject("material", "Hertz theory is small-strain linear elasticity: use linear-elastic");
+  s.geometry = Geometry::plane_strain;
+  s.force_free = true;
+  s.exact_motion = false;
+  const double R = c.real("radius"), delta = c.real("approach");
+  const double D = c.real("plate_depth"), W = c.real("plate_width");
+  if (delta > 0.05 * D)
+    c.reject("approach", fmt::format("must stay below 5 % of the plate's depth ({} m): Hertz theory is "
+                                     "small-strain",
+                                     0.05 * D));
+  const Lame lame = small_strain_lame(s.material);
+  const double E_star = analytic::contact_modulus_rigid(lame.youngs_modulus(), lame.poisson_ratio());
+  const double density = c.real("density");
+  const double omega = 0.5 * std::numbers::pi * std::sqrt(lame.mu / density) / D;
+  const QuasiStatic qs = quasi_static_from(c, omega);
+  s.smooth_until = qs.ramp_time;
+  // The plate starts at rest; the exact state is not a motion of the plate.
+  s.solution = mms::make_solution(analytic::RampedHomogeneousMotion{Mat2::Zero(), qs.ramp_time, D}, s.material,
+                                  density, s.geometry);
+
+  const int cells = int(c.integer("cells"));
+  const double h = D / cells;
+  s.grid = GridGeometry::walled(Vec2(0.0, -D), h, int(std::ceil(W / h - 1e-9)) + 3, cells + 4);
+  s.contains = [W, D](const Vec2& X) { return X.x() >= 0.0 && X.x() <= W && X.y() >= -D && X.y() <= 0.0; };
+#ifdef MPMVV_HAVE_CGAL
+  s.body = Body::rectangle(Vec2(0.0, -D), Vec2(W, 0.0));
+#endif
+  s.loading = fmt::format("rigid disk R = {} m moved {} m into the plate, frictionless contact; bottom clamped; "
+                          "grid damping",
+                          R, delta);
+  const double ramp_time = qs.ramp_time, damping = qs.damping;
+  s.stages = [=](const Particles&, const GridGeometry& grid) {
+    SceneStages stages;
+    stages.constraints.push_back({node_row(grid, -D), 0, [](double) { return 0.0; }});
+    RigidBody disk;
+    disk.kind = RigidBody::Kind::disk;
+    disk.point = Vec2(0.0, R);
+    disk.radius = R;
+    disk.displacement = [delta, ramp_time](double t) { return Vec2(0.0, -delta * analytic::ramp(t, ramp_time)); };
+    stages.contact = disk;
+    stages.damping = damping;
+    return stages;
+  };
+
+  auto record = std::make_shared<HertzRecord>();
+  s.extra_error_names = {"error_half_width", "error_peak_pressure", "error_pressure_profile"};
+  s.extra_errors = [=](double t, const RunRecord& run) {
+    const ContactReading r = read_contact(run.stepper.model().grid, run.stepper.contact_forces(), R, E_star);
+    record->x = r.x;
+    record->time.push_back(t);
+    record->pressure.push_back(r.pressure);
+    record->exact_pressure.push_back(r.exact_pressure);
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    if (!(r.load > 0.0)) return std::vector<double>{nan, nan, nan};
+    // Mean |p - p_Hertz| over the columns within 1.5 a, relative to p0.
+    double profile = 0.0;
+    int columns = 0;
+    for (std::size_t i = 0; i < r.x.size() && r.x[i] <= 1.5 * r.hertz.half_width(); ++i, ++columns)
+      profile += std::abs(r.pressure[i] - r.exact_pressure[i]);
+    return std::vector<double>{relative_error(r.half_width, r.hertz.half_width()),
+                               relative_error(r.peak_pressure, r.hertz.peak_pressure()),
+                               profile / std::max(columns, 1) / r.hertz.peak_pressure()};
+  };
+  s.measure = [=](const RunRecord& run) -> Measurements {
+    const ContactReading r = read_contact(run.stepper.model().grid, run.stepper.contact_forces(), R, E_star);
+    return {{"load", r.load},
+            {"approach", delta},
+            {"half_width", r.half_width},
+            {"half_width_exact", r.hertz.half_width()},
+            {"half_width_error", relative_error(r.half_width, r.hertz.half_width())},
+            {"contact_extent", r.extent},
+            {"peak_pressure", r.peak_pressure},
+            {"peak_pressure_exact", r.hertz.peak_pressure()},
+            {"peak_pressure_error", relative_error(r.peak_pressure, r.hertz.peak_pressure())},
+            {"half_width_over_h", r.half_width / run.stepper.model().grid.h},
+            {"half_width_over_depth", r.half_width / D}};
+  };
+  s.write_extra = [record](h5::Group& probes) {
+    h5::Group g = probes.create_group("contact_pressure");
+    g.set_attribute("description",
+                    "pressure of the contact on the plate at each output time, at cell midpoints x: half the "
+                    "vertical contact force of each bounding node column over the cell's width, and Hertz's "
+                    "p0 sqrt(1 - x^2 / a^2) at the load it sums to [Pa]");
+    const std::size_t n = record->x.size(), T = record->time.size();
+    std::vector<double> p, e;
+    for (std::size_t k = 0; k < T; ++k) {
+      p.insert(p.end(), record->pressure[k].begin(), record->pressure[k].end());
+      e.insert(e.end(), record->exact_pressure[k].begin(), record->exact_pressure[k].end());
+    }
+    g.write("x", record->x, {n});
+    g.write("time", record->time, {T});
+    g.write("pressure", p, {T, n});
+    g.write("exact_pressure", e, {T, n});
+  };
+  s.history_names = {"approach", "load"};
+  s.history = [=](double t, const Stepper& stepper) {
+    const ContactReading r = read_contact(stepper.model().grid, stepper.contact_forces(), R, E_star);
+    return std::vector<double>{delta * analytic::ramp(t, ramp_time), r.load};
+  };
+  return s;
+}
+
+}  // namespace
+
+MmsProblem hertz_cylinder_problem() {
+  return {"hertz-cylinder",
+          "rigid cylinder pressed into a steel plate, plane strain: contact half-width and pressure against Hertz "
+          "(PROBLEMS.md section 4)",
+          keys, setup};
+}
+
+}  // namespace mpmvv::app
