@@ -53,11 +53,15 @@ CIRCLE_POINTS = 16
 
 
 def write_case_results(path, keys, h, errors_at_times, times, status="completed", failure_reason="",
-                       failure_time=float("nan"), wall_time_s=1.0):
+                       failure_time=float("nan"), wall_time_s=1.0, contact_pressure=None, history=None,
+                       measurements=None):
     """A results file with the layout of reports/results-format.md: root attributes
     (every key, h, status, ...), /errors with `errors_at_times` (column -> values at
     `times`), and ring-like probes whose arrays reproduce the L1_theta0 column:
-    simulated = exact + that error at every point, so eq. 3.1 gives it back."""
+    simulated = exact + that error at every point, so eq. 3.1 gives it back.
+    Optionally /probes/contact_pressure (dict of its datasets x, time, pressure,
+    exact_pressure), /probes/history (dict: time and one array per scalar) and
+    /measurements (dict: attribute name -> value)."""
     end_time = float(keys.get("end_time", RING_TIMES[-1]))
     radius = np.linspace(0.75, 1.25, PROBE_POINTS)
     angle = np.linspace(0.0, 2.0 * np.pi, CIRCLE_POINTS, endpoint=False)
@@ -98,12 +102,20 @@ def write_case_results(path, keys, h, errors_at_times, times, status="completed"
         circle["angular_displacement"] = np.array([h * np.cos(4 * angle) for _ in times]).reshape(len(times), -1)
         circle["error_spectrum"] = np.array([[h * (k == 4) + 1e-12 for k in range(CIRCLE_POINTS // 2 + 1)]
                                              for _ in times]).reshape(len(times), -1)
+        for name, datasets in (("contact_pressure", contact_pressure), ("history", history)):
+            if datasets is not None:
+                group = probes.create_group(name)
+                for dataset, values in datasets.items():
+                    group[dataset] = np.asarray(values, float)
+        if measurements is not None:
+            f.create_group("measurements").attrs.update(measurements)
 
 
 def write_suite_directory(directory, suite_toml, cases):
     """DIR/suite.toml, DIR/manifest.json and DIR/cases/<id>.{h5,json} (suites/README.md).
     cases: dicts with id, study, keys, status and, for cases that ran, h, errors,
-    times (and optionally failure_reason, failure_time)."""
+    times (and optionally failure_reason, failure_time, contact_pressure, history,
+    measurements: see write_case_results)."""
     directory.mkdir(parents=True, exist_ok=True)
     (directory / "cases").mkdir(exist_ok=True)
     (directory / "suite.toml").write_text(suite_toml)
@@ -115,7 +127,9 @@ def write_suite_directory(directory, suite_toml, cases):
             write_case_results(directory / entry["results"], case["keys"], case["h"], case["errors"], case["times"],
                                status="failed" if case["status"] == "failed" else "completed",
                                failure_reason=case.get("failure_reason", ""),
-                               failure_time=case.get("failure_time", float("nan")))
+                               failure_time=case.get("failure_time", float("nan")),
+                               contact_pressure=case.get("contact_pressure"), history=case.get("history"),
+                               measurements=case.get("measurements"))
         (directory / "cases" / f"{case['id']}.json").write_text(json.dumps(entry))
         entries.append(entry)
     (directory / "manifest.json").write_text(json.dumps({"suite": "synthetic", "suite_file": "suites/synthetic.toml",
@@ -170,3 +184,63 @@ def synthetic_ring_cases(linear_fails_at_64=True):
 @pytest.fixture
 def synthetic_suite(tmp_path):
     return write_suite_directory(tmp_path / "suite", SYNTHETIC_SUITE, synthetic_ring_cases())
+
+
+HERTZ_SUITE = """description = "synthetic Hertz suite: contact pressure, load-approach history, measurements"
+
+[[study]]
+name = "mesh"
+scene = "scenes/hertz-cylinder.toml"
+sweep = { cells = [25, 50, 100, 200] }
+"""
+HERTZ_END_TIME = 0.002
+HERTZ_WIDTH = 0.2            # plate width [m]: h = HERTZ_WIDTH / cells
+
+
+def hertz_exact_pressure(x, p0, a):
+    """Hertz's p0 sqrt(1 - x^2/a^2), zero outside the contact."""
+    return p0 * np.sqrt(np.clip(1.0 - (np.asarray(x) / a) ** 2, 0.0, None))
+
+
+def hertz_load(cells):
+    """The load [N/m] each level measures: 2 % high on the coarsest, converging as h."""
+    return 2.2e7 * (1.0 + 0.5 / cells)
+
+
+def hertz_half_width(load):
+    """a [m] and p0 [Pa] of steel on steel (E* = 1.15e11 Pa, R = 2 m) at a load per unit length [N/m]."""
+    a = np.sqrt(4.0 * load * 2.0 / (np.pi * 1.15e11))
+    return float(a), float(2.0 * load / (np.pi * a))
+
+
+def hertz_cases(history=True, contact_pressure=True, measurements=True):
+    """cells 25, 50, 100 completed, 200 pending: /probes/contact_pressure at the one
+    output (simulated = exact (1 + 2 h / a) inside the contact), /probes/history with
+    approach ramped to 0.2 mm and load = approach x stiffness, and /measurements
+    (the 25-cell case has none)."""
+    cases = []
+    for cells in (25, 50, 100, 200):
+        keys = {"method": "cpdi", "cells": cells, "end_time": HERTZ_END_TIME, "output_times": [HERTZ_END_TIME]}
+        case = {"id": f"mesh-cells={cells}", "study": "mesh", "keys": keys, "status": "completed"}
+        if cells == 200:
+            case["status"] = "pending"
+            cases.append(case)
+            continue
+        h = HERTZ_WIDTH / cells
+        load = hertz_load(cells)
+        a, p0 = hertz_half_width(load)
+        x = (np.arange(cells // 2 + 2) + 0.5) * h
+        exact = hertz_exact_pressure(x, p0, a)
+        case.update(h=h, times=[HERTZ_END_TIME], errors={"error_peak_pressure": [0.5 / cells]})
+        if contact_pressure:
+            case["contact_pressure"] = {"x": x, "time": [HERTZ_END_TIME], "pressure": [exact * (1.0 + 2.0 * h / a)],
+                                        "exact_pressure": [exact]}
+        if history:
+            steps = np.linspace(0.0, HERTZ_END_TIME, 50 * cells // 25)
+            approach = 2e-4 * np.minimum(steps / (0.5 * HERTZ_END_TIME), 1.0)
+            case["history"] = {"time": steps, "approach": approach, "load": approach * load / 2e-4}
+        if measurements and cells != 25:
+            case["measurements"] = {"load": load, "half_width_exact": a, "peak_pressure_exact": p0,
+                                    "approach": 2e-4}
+        cases.append(case)
+    return cases

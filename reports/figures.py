@@ -14,7 +14,11 @@ returns a matplotlib Figure (Agg backend; no display needed):
   the difference below;
 * error_spectra: one-sided amplitude of mode m of the error around the ring's
   material circle (/probes/circle/error_spectrum); the exact motion is
-  axisymmetric, so every mode m > 0 is lost axisymmetry.
+  axisymmetric, so every mode m > 0 is lost axisymmetry;
+* pressure_profiles: simulated values as markers, one series per refinement
+  level, against an exact curve drawn as a line (the Hertz contact pressure);
+* histories: one line per case of a scalar against another recorded after
+  every step (the Hertz load against approach).
 """
 import math
 import textwrap
@@ -73,6 +77,14 @@ class ProfilePanel:
     title: str
     x: np.ndarray
     snapshots: list               # Snapshot, drawn against x
+
+
+@dataclass
+class LinePanel:
+    title: str
+    curves: list                  # Curve, one per case
+    exact: Curve = None           # drawn as a black line under the curves
+    marks: list = field(default_factory=list)   # (x, label): dotted vertical lines
 
 
 def _finite_positive(x, y):
@@ -262,6 +274,47 @@ def error_spectra(panels, title, y_label):
         else:
             _no_data(axes)
         _label_panel(axes, "angular mode m around the circle", y_label, panel_title)
+    _suptitle(figure, title)
+    return figure
+
+
+def pressure_profiles(panels, title, x_label, y_label):
+    """panels: LinePanel; each curve drawn as markers only, the exact curve as a line."""
+    return _line_panels(panels, title, x_label, y_label, markers=True)
+
+
+def histories(panels, title, x_label, y_label):
+    """panels: LinePanel; each curve drawn as a line (histories have a point per step)."""
+    return _line_panels(panels, title, x_label, y_label, markers=False)
+
+
+def _line_panels(panels, title, x_label, y_label, markers):
+    figure, axes_list = _panel_grid(len(panels), width=5.6, height=4.4)
+    for axes, panel in zip(axes_list, panels):
+        drawn = False
+        if panel.exact is not None and len(panel.exact.x):
+            axes.plot(panel.exact.x, panel.exact.y, "-", color="black", linewidth=1.6, alpha=0.75,
+                      label=panel.exact.label, zorder=1)
+            drawn = True
+        for curve in panel.curves:
+            if not len(curve.x):
+                continue
+            if markers:
+                axes.plot(curve.x, curve.y, linestyle="none", marker=curve.style.marker, markersize=5,
+                          color=curve.style.colour, label=curve.label, zorder=2)
+            else:
+                axes.plot(curve.x, curve.y, "-", color=curve.style.colour, linewidth=1.2, label=curve.label,
+                          zorder=2)
+            drawn = True
+        for x, label in panel.marks:
+            axes.axvline(x, color="grey", linestyle=":", linewidth=1.0)
+            axes.annotate(label, (x, 1.0), xycoords=("data", "axes fraction"), xytext=(3, -3),
+                          textcoords="offset points", ha="left", va="top", fontsize=8, color="grey")
+        if drawn:
+            axes.legend(fontsize=8)
+        else:
+            _no_data(axes)
+        _label_panel(axes, x_label, y_label, panel.title)
     _suptitle(figure, title)
     return figure
 

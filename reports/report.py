@@ -33,8 +33,8 @@ import figures
 import gate
 import norms
 import orders
-from results import (SuiteDirectoryError, lookup_error, read_error_spectrum, read_point_history,
-                     read_probe_lines, read_suite)
+from results import (SuiteDirectoryError, lookup_error, read_contact_pressure, read_error_spectrum,
+                     read_point_history, read_probe_lines, read_scene_history, read_suite)
 from series import DEFAULT_REFINE_KEY, refinement_series, series_levels, usable
 
 ORDERS_CSV_COLUMNS = (
@@ -428,6 +428,132 @@ def spectrum_figure(study, all_series, styles, directory):
                                     f"axisymmetry.")
 
 
+def level_label(series, case):
+    return f"{series.refine}={case.keys[series.refine]}"
+
+
+def level_styles(series):
+    """Colour and marker by a case's place in its series (coarse first), the same in
+    the contact-pressure and load-approach figures."""
+    return {c.id: figures.Style(figures.COLOURS[k % len(figures.COLOURS)], figures.MARKERS[k % len(figures.MARKERS)])
+            for k, c in enumerate(series.cases)}
+
+
+def hertz_ellipse(x, exact):
+    """(p0, a) of the curve p0 sqrt(1 - x^2/a^2) the nonzero exact pressures lie on
+    (p^2 is linear in x^2), or None with fewer than two such points or when they
+    do not lie on one."""
+    x, p = np.asarray(x, float), np.asarray(exact, float)
+    on = np.isfinite(x) & np.isfinite(p) & (p > 0)
+    if on.sum() < 2 or np.unique(np.abs(x[on])).size < 2:
+        return None
+    slope, intercept = np.polyfit(x[on] ** 2, p[on] ** 2, 1)
+    if not (intercept > 0 and slope < 0):
+        return None
+    p0, a = math.sqrt(intercept), math.sqrt(-intercept / slope)
+    fitted = p0 * np.sqrt(np.clip(1.0 - (x[on] / a) ** 2, 0.0, None))
+    return (p0, a) if np.max(np.abs(fitted - p[on])) <= 1e-6 * p0 else None
+
+
+def contact_extent(x, exact):
+    """The largest |x| where the exact pressure is nonzero (NaN when it is zero everywhere)."""
+    x, p = np.asarray(x, float), np.asarray(exact, float)
+    on = np.isfinite(p) & (p > 0)
+    return float(np.max(np.abs(x[on]))) if on.any() else float("nan")
+
+
+def exact_pressure_curve(label, x, exact, x_max):
+    """The exact profile in mm and MPa up to x_max: Hertz's ellipse drawn densely when the
+    stored values lie on one (with its (p0, a)), else the stored values at the cell midpoints."""
+    ellipse = hertz_ellipse(x, exact)
+    if ellipse is None:
+        keep = np.abs(x) <= x_max
+        return figures.Curve(f"exact, {label}", x[keep] * 1e3, exact[keep] / 1e6), None
+    p0, a = ellipse
+    theta = np.linspace(0.0, 0.5 * np.pi, 200)
+    side = np.concatenate([a * np.sin(theta), [max(x_max, a)]])
+    pressure = np.concatenate([p0 * np.cos(theta), [0.0]])
+    if np.min(x) < 0:
+        side, pressure = np.concatenate([-side[::-1], side]), np.concatenate([pressure[::-1], pressure])
+    return figures.Curve(f"Hertz at the load of {label}", side * 1e3, pressure / 1e6), ellipse
+
+
+def contact_pressure_figure(study, all_series, directory):
+    """Simulated contact pressure at each case's last output (markers, one series per
+    level) against the exact curve of the series' finest case, x up to twice its
+    contact half-width; None when no case has /probes/contact_pressure."""
+    found = []
+    for series in all_series:
+        profiles = [(c, p) for c in series.cases if c.results is not None
+                    for p in [read_contact_pressure(c.results_path)] if p is not None]
+        if profiles:
+            found.append((series, profiles))
+    if not found:
+        return None
+    last_times = [p.time[-1] for _, profiles in found for _, p in profiles]
+    common = max(last_times)
+    panels = []
+    for series, profiles in found:
+        styles = level_styles(series)
+        finest_case, finest = profiles[-1]
+        extent = contact_extent(finest.x, finest.exact[-1])
+        x_max = 2.0 * extent if extent > 0 else float(np.max(np.abs(finest.x)))
+        curves = []
+        for case, profile in profiles:
+            keep = np.abs(profile.x) <= x_max * (1.0 + 1e-9)
+            label = level_label(series, case)
+            if not math.isclose(profile.time[-1], common) or not case.completed:
+                label += f" ({case.status}, {time_text(profile.time[-1])})"
+            curves.append(figures.Curve(label, profile.x[keep] * 1e3, profile.pressure[-1][keep] / 1e6,
+                                        styles[case.id]))
+        exact, ellipse = exact_pressure_curve(level_label(series, finest_case), finest.x, finest.exact[-1], x_max)
+        title, marks = series.label, []
+        if ellipse is not None:
+            p0, a = ellipse
+            title += f"\nHertz at {level_label(series, finest_case)}: p0 = {p0 / 1e6:.4g} MPa, a = {a * 1e3:.4g} mm"
+            marks = [(a * 1e3, "a")]
+        panels.append(figures.LinePanel(title, curves, exact, marks))
+    when = time_text(common) if all(math.isclose(t, common) for t in last_times) else "the last output of each case"
+    figure = figures.pressure_profiles(panels, f"{study}: contact pressure at {when}", "distance x from the axis [mm]",
+                                       "contact pressure [MPa]")
+    path = directory / f"{slug(study, 'contact-pressure')}.png"
+    figures.save_png(figure, path)
+    refine = found[0][0].refine
+    return FigureEntry(study, path, f"{study}: contact pressure on the plate [MPa] against distance x from the axis "
+                                    f"[mm] at {when} (/probes/contact_pressure); markers: simulated at the cell "
+                                    f"midpoints, one series per {refine} level; line: the exact (Hertz) pressure "
+                                    f"p0 sqrt(1 - x^2/a^2) at the load the finest case measured, dotted at its "
+                                    f"half-width a; x up to twice the largest x where that exact pressure is "
+                                    f"nonzero.")
+
+
+def load_approach_figure(study, all_series, directory):
+    """Load against approach from /probes/history after every step, one line per case;
+    None when no case has a history with datasets `approach` and `load`."""
+    panels = []
+    for series in all_series:
+        styles = level_styles(series)
+        curves = []
+        for case in series.cases:
+            history = read_scene_history(case.results_path) if case.results is not None else None
+            if history is None or not {"approach", "load"} <= history.values.keys():
+                continue
+            label = level_label(series, case)
+            if not case.completed:
+                label += f" ({case.status} at {time_text(history.time[-1])})"
+            curves.append(figures.Curve(label, history.values["approach"] * 1e6, history.values["load"] / 1e6,
+                                        styles[case.id]))
+        if curves:
+            panels.append(figures.LinePanel(series.label, curves))
+    if not panels:
+        return None
+    figure = figures.histories(panels, f"{study}: load against approach", "approach [µm]", "load [MN/m]")
+    path = directory / f"{slug(study, 'load-approach')}.png"
+    figures.save_png(figure, path)
+    return FigureEntry(study, path, f"{study}: load per unit length [MN/m] against approach [µm] after every step "
+                                    f"(/probes/history), one line per case, by {all_series[0].refine}.")
+
+
 def study_figures(suite, study, rows, directory):
     cases = suite.cases_of(study)
     all_series = study_series(suite, study)
@@ -444,6 +570,8 @@ def study_figures(suite, study, rows, directory):
     entries.append(stability_figure(study, all_series, directory))
     entries.append(profile_figure(study, all_series, directory))
     entries.append(history_figure(study, all_series, directory))
+    entries.append(contact_pressure_figure(study, all_series, directory))
+    entries.append(load_approach_figure(study, all_series, directory))
     entries.append(spectrum_figure(study, all_series, styles, directory))
     return [e for e in entries if e is not None]
 
@@ -456,6 +584,7 @@ class Table:
     headers: list
     rows: list                   # lists of strings
     css: list = None             # optional CSS class per row
+    kind: str = ""               # optional CSS class of the table
 
 
 def number(value, spec=".3g"):
@@ -471,6 +600,42 @@ def case_table(suite):
         css.append(c.status)
     return Table(["case", "status", "reached / end time [s]", "failure reason", "wall time [s]", "steps",
                   "particles"], rows, css)
+
+
+def measurement_text(value):
+    """4 significant digits for numbers (nan shown as such), text as it is."""
+    if isinstance(value, (bool, np.bool_)):
+        return str(value)
+    if isinstance(value, (int, float, np.number)):
+        return format(float(value), ".4g")
+    if isinstance(value, np.ndarray):
+        return ", ".join(measurement_text(v) for v in value.ravel())
+    return str(value)
+
+
+def measurement_table(cases):
+    """Rows = the cases, columns = every /measurements attribute they have (first-seen
+    order); None when no case has one."""
+    names = list(dict.fromkeys(n for c in cases if c.results for n in c.results.measurements))
+    if not names:
+        return None
+    rows = []
+    for c in cases:
+        measured = c.results.measurements if c.results else {}
+        rows.append([c.id] + [measurement_text(measured[n]) if n in measured else "-" for n in names])
+    return Table(["case"] + names, rows, kind="measurements")
+
+
+def measurement_sections(suite):
+    sections = []
+    for study in suite.study_names():
+        table = measurement_table(suite.cases_of(study))
+        if table is not None:
+            sections.append((f"Measurements: {study}", f"The /measurements attributes of each case of study {study} "
+                             "(4 significant digits; - where a case has none): what the scene measures at the end "
+                             "of the run; an attribute ending in _exact is the exact value of the one without the "
+                             "suffix, one ending in _error its relative error (reports/results-format.md).", table))
+    return sections
 
 
 def order_cells(row):
@@ -589,6 +754,7 @@ def build_report(suite, figure_directory):
             sections.append(("Expectations", f"As checked by mpmvv gate: {summary}.", expectation_table(verdicts)))
         except SuiteDirectoryError as error:
             sections.append(("Expectations", f"Not checked: {error}", None))
+    sections += measurement_sections(suite)
     fitted = [r for r in rows if len(r.levels) >= 2]
     sections.append(("Observed orders", DEFINITIONS + f" {len(rows) - len(fitted)} of {len(rows)} (series, norm, "
                      "time) combinations have fewer than two usable levels and are left out here. orders.csv has "
@@ -629,16 +795,19 @@ tr.FAIL td:nth-child(10), tr.stalled td:last-child { color: #c62828; font-weight
 tr.pending td:nth-child(2), tr.non-asymptotic td:last-child { color: #9a6700; }
 figure { margin: 1em 0 2em; } figure img { max-width: 100%; border: 1px solid #eee; }
 figcaption { font-size: 0.9em; color: #444; }
+table.measurements td + td { white-space: nowrap; }
 """
 
 
 def html_table(table):
-    head = "".join(f"<th>{html.escape(h)}</th>" for h in table.headers)
+    # a header may break after an underscore (long /measurements names)
+    head = "".join(f"<th>{html.escape(h).replace('_', '_<wbr>')}</th>" for h in table.headers)
     body = []
     for index, row in enumerate(table.rows):
         css = f' class="{html.escape(table.css[index])}"' if table.css else ""
         body.append(f"<tr{css}>" + "".join(f"<td>{html.escape(cell)}</td>" for cell in row) + "</tr>")
-    return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
+    kind = f" class='{html.escape(table.kind)}'" if table.kind else ""
+    return f"<table{kind}><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
 
 
 def render_html(report):

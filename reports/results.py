@@ -9,8 +9,9 @@ A case's status is the manifest's (completed, failed, crashed, timeout, error,
 pending). A case without a readable results file (pending, crashed, timeout,
 error, or a damaged file) is kept with ``results = None`` and a note saying why,
 so that every report and the gate can show it instead of stopping on it.
-Only root attributes and /errors are read up front; probe arrays are read on
-demand for the few cases that are plotted.
+Only root attributes, /errors and the /measurements scalars are read up front;
+probe arrays (lines, points, the circle, /probes/contact_pressure,
+/probes/history) are read on demand for the few cases that are plotted.
 """
 import json
 import math
@@ -37,6 +38,7 @@ class CaseResults:
     error_times: np.ndarray
     errors: dict                  # /errors column name -> values at error_times
     line_quantities: dict         # probe line name -> its 'quantity' attribute
+    measurements: dict = field(default_factory=dict)   # /measurements attributes: name -> value
 
 
 @dataclass(frozen=True)
@@ -182,7 +184,8 @@ def _plain(value):
 
 
 def read_case_results(path):
-    """Root attributes, /errors and the probe lines' quantities of one results file."""
+    """Root attributes, /errors, the probe lines' quantities and the /measurements
+    attributes of one results file."""
     with h5py.File(path, "r") as f:
         attributes = {name: _plain(value) for name, value in f.attrs.items()}
         errors_group = f.get("errors")
@@ -195,7 +198,10 @@ def read_case_results(path):
             quantity = _plain(group.attrs.get("quantity", ""))
             if name != "circle" and quantity in group and group[quantity].ndim == 2:
                 line_quantities[name] = quantity
-    return CaseResults(attributes, error_times, errors, line_quantities)
+        measurements_group = f.get("measurements")
+        measurements = ({name: _plain(value) for name, value in measurements_group.attrs.items()}
+                        if isinstance(measurements_group, h5py.Group) else {})
+    return CaseResults(attributes, error_times, errors, line_quantities, measurements)
 
 
 def lookup_error(case, norm, time):
@@ -285,3 +291,47 @@ def read_error_spectrum(path):
         return ErrorSpectrum(_plain(circle.attrs.get("quantity", "")),
                              float(circle.attrs.get("reference_radius", float("nan"))),
                              np.asarray(circle["time"][:], float), np.asarray(circle["error_spectrum"][:], float))
+
+
+@dataclass(frozen=True)
+class ContactPressure:
+    x: np.ndarray                 # n cell midpoints [m]
+    time: np.ndarray              # T output times
+    pressure: np.ndarray          # T x n simulated contact pressure [Pa]
+    exact: np.ndarray             # T x n Hertz's pressure at the load the run measured [Pa]
+
+
+@dataclass(frozen=True)
+class SceneHistory:
+    time: np.ndarray              # S step times
+    values: dict                  # name -> S values of a scalar recorded after every step
+
+
+def read_contact_pressure(path):
+    """/probes/contact_pressure (hertz-cylinder), or None when absent or without an output."""
+    with h5py.File(path, "r") as f:
+        group = f.get("probes/contact_pressure")
+        if not isinstance(group, h5py.Group) or any(n not in group for n in ("x", "time", "pressure",
+                                                                              "exact_pressure")):
+            return None
+        x = np.asarray(group["x"][:], float)
+        time = np.asarray(group["time"][:], float)
+        if time.size == 0 or x.size == 0:
+            return None
+        shape = (time.size, x.size)
+        return ContactPressure(x, time, np.asarray(group["pressure"][:], float).reshape(shape),
+                               np.asarray(group["exact_pressure"][:], float).reshape(shape))
+
+
+def read_scene_history(path):
+    """/probes/history: its time and every scalar recorded with it, or None when absent or empty."""
+    with h5py.File(path, "r") as f:
+        group = f.get("probes/history")
+        if not isinstance(group, h5py.Group) or "time" not in group or "quantity" in group.attrs:
+            return None
+        time = np.asarray(group["time"][:], float)
+        if time.size == 0:
+            return None
+        values = {name: np.asarray(group[name][:], float) for name in group
+                  if name != "time" and isinstance(group[name], h5py.Dataset) and group[name].shape == time.shape}
+        return SceneHistory(time, values)

@@ -1,15 +1,21 @@
 """Requirements of the report (reports/report.py): it renders for a suite with
 failed, crashed and pending cases and for the stored gold results directory;
-report.html is self-contained; orders.csv holds the observed orders."""
+report.html is self-contained; orders.csv holds the observed orders; the
+contact-pressure and load-approach figures and the measurements tables appear
+for the cases that have /probes/contact_pressure, /probes/history and
+/measurements, and only then."""
 import csv
 import re
 from pathlib import Path
 
+import numpy as np
 import pytest
 
+import figures
 import gate
 import report
-from conftest import SYNTHETIC_SUITE, synthetic_ring_cases, write_suite_directory
+from conftest import (HERTZ_END_TIME, HERTZ_SUITE, SYNTHETIC_SUITE, hertz_cases, hertz_exact_pressure,
+                      hertz_half_width, hertz_load, synthetic_ring_cases, write_suite_directory)
 
 GOLD = Path(__file__).parent / "gold"
 
@@ -92,3 +98,106 @@ def test_gold_results_directory_renders_and_gates(tmp_path):
     written, figure_count = render(GOLD, tmp_path / "gold-report")
     assert written["html"].stat().st_size > 0 and figure_count > 0
     assert gate.main([str(GOLD)]) in (0, 1)
+
+
+RING_FIGURES = ["ring-error-L1_theta0-end.png", "ring-error-particle_L2-end.png", "ring-history-point_R1.png",
+                "ring-profile-theta0.png", "ring-spectrum.png", "ring-stability.png", "ring-work-precision.png"]
+
+
+def test_suite_without_contact_history_or_measurements_renders_as_before(synthetic_report):
+    """Requirement: a suite whose results files have no /probes/contact_pressure,
+    /probes/history or /measurements gets exactly the figures and sections it got
+    before they were added: no contact-pressure or load-approach figure, no
+    measurements table."""
+    output, written, figure_count = synthetic_report
+    assert sorted(p.name for p in (output / "figures").glob("*.png")) == RING_FIGURES
+    markdown = written["markdown"].read_text()
+    assert re.findall(r"^## .*", markdown, re.M) == ["## Cases", "## Expectations", "## Observed orders",
+                                                     "## Richardson extrapolation and grid convergence index",
+                                                     "## Figures"]
+    assert "Measurements" not in written["html"].read_text()
+
+
+@pytest.fixture
+def drawn(monkeypatch):
+    """The panels handed to figures.pressure_profiles and figures.histories, by figure title."""
+    calls = {}
+    for name in ("pressure_profiles", "histories"):
+        original = getattr(figures, name)
+
+        def record(panels, title, *args, _original=original, **kwargs):
+            calls[title] = panels
+            return _original(panels, title, *args, **kwargs)
+        monkeypatch.setattr(figures, name, record)
+    return calls
+
+
+def test_contact_pressure_figure_of_each_level_against_hertz(tmp_path, drawn):
+    """Requirement: for cases with /probes/contact_pressure the report draws, per
+    study, the simulated pressure at each case's last output (markers, one series
+    per refinement level labelled by the refine key) against the exact curve of
+    the finest case (a line), x in mm and pressure in MPa, x up to twice the
+    largest x with nonzero exact pressure; the caption names the time."""
+    directory = write_suite_directory(tmp_path / "suite", HERTZ_SUITE, hertz_cases())
+    written, figure_count = render(directory, tmp_path / "out")
+    assert (tmp_path / "out" / "figures" / "mesh-contact-pressure.png").is_file()
+    (panel,) = drawn[f"mesh: contact pressure at t = {HERTZ_END_TIME:g} s"]
+    assert [c.label for c in panel.curves] == ["cells=25", "cells=50", "cells=100"]     # 200 is pending
+    cells, a, p0 = 100, *hertz_half_width(hertz_load(100))
+    h = 0.2 / cells
+    x = (np.arange(cells // 2 + 2) + 0.5) * h
+    extent = x[hertz_exact_pressure(x, p0, a) > 0].max()
+    finest = panel.curves[-1]
+    assert np.allclose(finest.x, 1e3 * x[x <= 2 * extent])
+    assert np.allclose(finest.y, 1e-6 * hertz_exact_pressure(x[x <= 2 * extent], p0, a) * (1 + 2 * h / a))
+    assert max(max(c.x) for c in panel.curves) <= 2e3 * extent * (1 + 1e-9)
+    assert np.allclose(panel.exact.y, 1e-6 * hertz_exact_pressure(1e-3 * panel.exact.x, p0, a), atol=1e-9)
+    assert max(panel.exact.y) == pytest.approx(p0 / 1e6) and max(panel.exact.x) == pytest.approx(2e3 * extent)
+    assert report.hertz_ellipse(x, hertz_exact_pressure(x, p0, a)) == pytest.approx((p0, a))
+    page = written["html"].read_text()
+    assert page.count("src='data:image/png;base64,") == figure_count
+    assert re.search(r"<figcaption>mesh: contact pressure [^<]*at t = 0\.002 s", page)
+
+
+def test_load_approach_figure_one_line_per_case(tmp_path, drawn):
+    """Requirement: for cases whose /probes/history has `approach` and `load` the
+    report draws load [MN/m] against approach [um], one line per case of the study."""
+    directory = write_suite_directory(tmp_path / "suite", HERTZ_SUITE, hertz_cases(contact_pressure=False))
+    written = render(directory, tmp_path / "out")[0]
+    assert sorted(p.name for p in (tmp_path / "out" / "figures").glob("*load*")) == ["mesh-load-approach.png"]
+    assert not list((tmp_path / "out" / "figures").glob("*contact-pressure*"))
+    (panel,) = drawn["mesh: load against approach"]
+    assert [c.label for c in panel.curves] == ["cells=25", "cells=50", "cells=100"]
+    for curve, cells in zip(panel.curves, (25, 50, 100)):
+        assert max(curve.x) == pytest.approx(200.0) and max(curve.y) == pytest.approx(hertz_load(cells) / 1e6)
+    assert "mesh: load per unit length [MN/m] against approach" in written["html"].read_text()
+
+
+def test_history_without_approach_and_load_draws_nothing(tmp_path):
+    """Requirement: a /probes/history without both `approach` and `load` is skipped."""
+    cases = hertz_cases(contact_pressure=False, measurements=False)
+    for case in cases:
+        if "history" in case:
+            case["history"] = {"time": case["history"]["time"], "energy": case["history"]["load"]}
+    directory = write_suite_directory(tmp_path / "suite", HERTZ_SUITE, cases)
+    render(directory, tmp_path / "out")
+    names = [p.name for p in (tmp_path / "out" / "figures").glob("*.png")]
+    assert names and not [n for n in names if "load" in n or "contact" in n]
+
+
+def test_measurements_table_lists_every_attribute_per_case(tmp_path):
+    """Requirement: when some case of a study has /measurements, report.md and
+    report.html have a "Measurements" table for the study: one row per case, one
+    column per attribute present, numbers to 4 significant digits, - where a case
+    has none."""
+    directory = write_suite_directory(tmp_path / "suite", HERTZ_SUITE, hertz_cases())
+    written = render(directory, tmp_path / "out")[0]
+    markdown = written["markdown"].read_text()
+    assert "## Measurements: mesh" in markdown
+    assert "| case | approach | half_width_exact | load | peak_pressure_exact |" in markdown    # as HDF5 lists them
+    a, p0 = hertz_half_width(hertz_load(50))
+    assert f"| mesh-cells=50 | 0.0002 | {a:.4g} | {hertz_load(50):.4g} | {p0:.4g} |" in markdown
+    assert "| mesh-cells=25 | - | - | - | - |" in markdown and "| mesh-cells=200 | - | - | - | - |" in markdown
+    page = written["html"].read_text()
+    assert "<h2>Measurements: mesh</h2>" in page and f"<td>{hertz_load(100):.4g}</td>" in page
+    assert report.measurement_text(0.015854621348) == "0.01585" and report.measurement_text(2.2454e7) == "2.245e+07"
