@@ -6,6 +6,8 @@
 #include <cstddef>
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "boundary.hpp"
 #include "model.hpp"
@@ -41,6 +43,11 @@ class Stepper {
   // With a contact master, the contact force of the last step at each node;
   // empty without one.
   const ContactForces& contact_forces() const { return contact_forces_; }
+  // Why the last step could not be taken (an implicit solve that did not
+  // converge); empty when it was.
+  virtual std::string step_failure() const { return {}; }
+  // Counters of the stepper's own (Newton and Krylov iterations), for the results file.
+  virtual std::vector<std::pair<std::string, double>> statistics() const { return {}; }
 
  protected:
   explicit Stepper(Model model) : model_(std::move(model)) { fields_.resize(model_.grid.node_count()); }

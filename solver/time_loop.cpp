@@ -55,7 +55,7 @@ RunOutcome run_time_loop(Stepper& stepper, const TimeLoopOptions& options, RunOb
   if (scan.first_unhealthy < n) fail(scan, t);
 
   while (out.failure_reason.empty() && next_output < options.output_times.size()) {
-    double dt = options.cfl * h / scan.max_signal_speed;
+    double dt = options.fixed_step > 0.0 ? options.fixed_step : options.cfl * h / scan.max_signal_speed;
     if (!std::isfinite(dt) || dt < smallest_step) {
       out.failure_reason = "time step collapsed";
       out.failure_detail = "CFL step " + std::to_string(dt) + " s";
@@ -85,6 +85,13 @@ RunOutcome run_time_loop(Stepper& stepper, const TimeLoopOptions& options, RunOb
     stepper.step(t, dt, kick);
     previous_dt = dt;
     ++out.steps;
+    if (const std::string why = stepper.step_failure(); !why.empty()) {
+      out.failure_reason = "no equilibrium";
+      out.failure_detail = why;
+      out.failure_time = t;
+      out.failure_step = out.steps;
+      break;
+    }
     t = lands ? target : t + dt;
     observer.after_step(t, stepper);
 

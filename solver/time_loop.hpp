@@ -32,6 +32,9 @@ struct TimeLoopOptions {
   // particle's current state plus its speed.
   double cfl = 0.5;
   TimeIntegration time_integration = TimeIntegration::central_difference;
+  // When positive, every step is this long instead of the CFL step (the load
+  // steps of an implicit static run).
+  double fixed_step = 0.0;
   // Strictly increasing, positive; the last one is the end time.
   std::vector<double> output_times;
 };

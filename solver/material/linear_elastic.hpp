@@ -30,6 +30,8 @@ struct LinearElastic {
   }
 
   double p_wave_modulus() const { return lambda + 2.0 * mu; }
+  // The small-strain Lame constants (lambda, mu).
+  SmallStrainModuli small_strain_moduli() const { return {lambda, mu}; }
   // The tangent is constant: rho c^2 = lambda + 2 mu in every state.
   double wave_modulus(const Mat2&, double, const Mat2&) const { return p_wave_modulus(); }
   double wave_modulus(const Mat2& F, const Mat2& sigma) const { return wave_modulus(F, 1.0, sigma); }

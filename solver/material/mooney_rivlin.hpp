@@ -50,6 +50,8 @@ struct MooneyRivlin {
 
   double shear_modulus() const { return 2.0 * (c1 + c2); }
   double p_wave_modulus() const { return bulk_modulus + 4.0 / 3.0 * shear_modulus(); }
+  // The small-strain Lame constants: mu = 2 (C1 + C2), lambda = K - 2 mu / 3.
+  SmallStrainModuli small_strain_moduli() const { return {bulk_modulus - 2.0 / 3.0 * shear_modulus(), shear_modulus()}; }
 
   // Estimate of rho c^2 at the current state, for the time step. The volumetric
   // Kirchhoff stress K ln J I has the spatial tangent K I(x)I - 2 K ln J II,

@@ -37,6 +37,8 @@ struct NeoHookean {
 
   // Small-strain P-wave modulus lambda + 2 mu.
   double p_wave_modulus() const { return lambda + 2.0 * mu; }
+  // The small-strain Lame constants (lambda, mu).
+  SmallStrainModuli small_strain_moduli() const { return {lambda, mu}; }
 
   // Upper bound of rho c^2 over in-plane directions at the current state, for
   // the time step. The spatial tangent of the Kirchhoff stress is

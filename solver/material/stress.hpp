@@ -8,6 +8,12 @@
 
 namespace mpmvv {
 
+// A material's Lame constants at small strain: the tangent an implicit step
+// preconditions its Newton systems with.
+struct SmallStrainModuli {
+  double lambda, mu;
+};
+
 template <class T>
 struct Stress {
   Eigen::Matrix<T, 2, 2> in_plane;

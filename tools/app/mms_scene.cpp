@@ -1,6 +1,9 @@
 #include "mms_scene.hpp"
 
 #include "fault.hpp"
+#ifdef MPMVV_HAVE_SUNDIALS
+#include "solver/implicit/static_stepper.hpp"
+#endif
 
 #include <cmath>
 #include <numbers>
@@ -143,9 +146,25 @@ class MmsCase final : public SceneCase, private RunObserver {
       if (!stages.body_force) stages.body_force = std::make_shared<mms::DerivedBodyForce>(setup_.solution);
       if (fault_ == Fault::no_body_force) stages.body_force = nullptr;
     }
-    stepper_ = make_stepper(std::move(model), options_, setup_.material, std::move(stages));
+    if (implicit()) {
+#ifdef MPMVV_HAVE_SUNDIALS
+      const double ramp = std::isfinite(setup_.smooth_until) ? setup_.smooth_until : loop_.end_time;
+      loop_.fixed_step = ramp / double(config_.integer("load_steps"));
+      stepper_ = make_static_stepper(std::move(model), options_, setup_.material, std::move(stages), StaticOptions{});
+#else
+      throw ConfigError("solver = \"implicit\" needs SUNDIALS (built without it: MPMVV_WITH_SUNDIALS=OFF)");
+#endif
+    } else {
+      stepper_ = make_stepper(std::move(model), options_, setup_.material, std::move(stages));
+    }
     outcome_ = run_time_loop(*stepper_, loop_, *this, progress);
     return outcome_;
+  }
+
+  bool implicit() const {
+    for (const KeySpec& k : config_.specs())
+      if (k.name == "solver") return config_.text("solver") == "implicit";
+    return false;
   }
 
   double cell_size() const override { return setup_.grid.h; }
@@ -155,8 +174,11 @@ class MmsCase final : public SceneCase, private RunObserver {
     return setup_.fast_body_force ? "closed form" : "derived";
   }
   Measurements measurements() const override {
-    if (!setup_.measure || !stepper_) return {};
-    return setup_.measure(RunRecord{point_time_, point_simulated_, *stepper_});
+    if (!stepper_) return {};
+    Measurements m;
+    if (setup_.measure) m = setup_.measure(RunRecord{point_time_, point_simulated_, *stepper_});
+    for (const auto& s : stepper_->statistics()) m.push_back(s);
+    return m;
   }
   std::string seeding() const override { return exact_seeding_ ? "exact" : "centre"; }
   double particle_volume() const override { return particle_volume_; }

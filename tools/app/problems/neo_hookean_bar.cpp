@@ -4,8 +4,11 @@
 // (000_1dbcb8acb6dddab9.txt eq. 2.2; a scalar root by KINSOL,
 // analytic/uniaxial.hpp), and the end carries the nominal traction
 // P = sigma_xx l2 per unit reference height. The bar [0, L] x [0, H/2] is the
-// upper half (symmetry plane y = 0) on a frictionless support x = 0; the end
-// particles carry P, ramped (analytic/quasi_static.hpp); damping settles it.
+// upper half (symmetry plane y = 0) on a frictionless support x = 0. In
+// tension the end particles carry P, ramped (analytic/quasi_static.hpp); in
+// compression a dead load on a free end folds the loaded column of particles,
+// so a rigid platen (a half-plane in frictionless contact, solver/contact.hpp)
+// pushes the end to l1 L instead, and its force is the load. Damping settles it.
 // The static state is homogeneous: read in the middle half of the bar, the
 // mean stretches and stress of its particles against (l1, l2, sigma_xx). The
 // exact motion X + r(t) (F - I) X is exact at rest and from the end of the
@@ -79,9 +82,23 @@ ProblemSetup setup(const Config& c) {
 #ifdef MPMVV_HAVE_CGAL
   s.body = Body::rectangle(Vec2::Zero(), Vec2(L, half));
 #endif
-  s.loading = fmt::format("dead load {:.9g} N/m per unit reference height on the end x = L, grid damping", nominal);
+  const bool platen = l1 < 1.0;
+  s.loading = platen ? fmt::format("rigid platen moved from x = L to {} L, frictionless contact, grid damping", l1)
+                     : fmt::format("dead load {:.9g} N/m per unit reference height on the end x = L, grid damping",
+                                   nominal);
   const double ramp_time = qs.ramp_time, damping = qs.damping;
   s.stages = [=](const Particles& P, const GridGeometry&) {
+    if (platen) {
+      SceneStages stages;
+      RigidBody plate;
+      plate.kind = RigidBody::Kind::half_plane;
+      plate.point = Vec2(L, 0.0);
+      plate.outward = Vec2(-1.0, 0.0);
+      plate.displacement = [=](double t) { return Vec2((l1 - 1.0) * L * analytic::ramp(t, ramp_time), 0.0); };
+      stages.contact = plate;
+      stages.damping = damping;
+      return stages;
+    }
     // The last sub-column of particles carries the end: each its share of
     // the height, its reference area over the sub-cell width.
     std::vector<std::size_t> loaded;
@@ -121,6 +138,7 @@ ProblemSetup setup(const Config& c) {
             {"axial_stress_exact", sigma},
             {"axial_stress_error", relative_error(m.stress(0, 0), sigma)},
             {"nominal_traction", nominal},
+            {"platen_nominal_traction", platen ? record.stepper.contact_forces().total.x() / half : 0.0},
             {"root_iterations", double(exact.iterations)},
             {"middle_particles", double(m.particles)}};
   };

@@ -15,6 +15,12 @@ std::vector<KeySpec> static_scene_keys(std::vector<KeySpec> k, const std::vector
   const double inf = std::numeric_limits<double>::infinity();
   k.insert(k.end(), own.begin(), own.end());
   const std::vector<KeySpec> load = {
+      {"solver", KeyKind::text, std::string("explicit"),
+       "explicit: the load ramped in time, grid damping settles the body (dynamic relaxation); implicit: "
+       "quasi-static load steps, each solved for equilibrium by KINSOL's Newton-Krylov method",
+       -inf, inf, false, false, {"explicit", "implicit"}},
+      {"load_steps", KeyKind::integer, std::int64_t(4),
+       "implicit: equal steps over the ramp (then steps of that length at full load to the end time)", 1, 100000},
       {"ramp_periods", KeyKind::real, 4.0,
        "the load rises over this many periods of the body's lowest mode, (1 - cos(pi t / T)) / 2, then holds", 0.0,
        inf, true},
@@ -89,16 +95,8 @@ RegionMeans region_means(const Particles& P, const std::function<bool(const Vec2
 }
 
 Lame small_strain_lame(const MaterialModel& m) {
-  return std::visit(
-      [](const auto& x) -> Lame {
-        if constexpr (requires { x.lambda; }) {
-          return {x.lambda, x.mu};
-        } else {
-          const double mu = x.shear_modulus();
-          return {x.bulk_modulus - 2.0 / 3.0 * mu, mu};
-        }
-      },
-      m);
+  const SmallStrainModuli s = std::visit([](const auto& x) { return x.small_strain_moduli(); }, m);
+  return {s.lambda, s.mu};
 }
 
 double relative_error(double measured, double exact) {
