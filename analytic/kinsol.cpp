@@ -1,5 +1,7 @@
 #include "kinsol.hpp"
 
+#include "solver/implicit/sundials.hpp"
+
 #include <kinsol/kinsol.h>
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_context.h>
@@ -14,36 +16,13 @@ namespace mpmvv::analytic {
 
 namespace {
 
-void check(int flag, const char* call) {
-  if (flag < 0) throw SundialsError(std::string("SUNDIALS ") + call + " failed with flag " + std::to_string(flag));
-}
-
-template <class T>
-T* check_pointer(T* p, const char* call) {
-  if (!p) throw SundialsError(std::string("SUNDIALS ") + call + " returned no object");
-  return p;
-}
-
-struct Context {
-  SUNContext context = nullptr;
-  Context() { check(SUNContext_Create(nullptr, &context), "SUNContext_Create"); }
-  ~Context() { SUNContext_Free(&context); }
-  Context(const Context&) = delete;
-  Context& operator=(const Context&) = delete;
-};
-
-struct VectorDeleter {
-  void operator()(_generic_N_Vector* v) const { N_VDestroy(v); }
-};
-struct MatrixDeleter {
-  void operator()(_generic_SUNMatrix* m) const { SUNMatDestroy(m); }
-};
-struct LinearSolverDeleter {
-  void operator()(_generic_SUNLinearSolver* s) const { SUNLinSolFree(s); }
-};
-struct KinsolDeleter {
-  void operator()(void* k) const { KINFree(&k); }
-};
+using sundials::check;
+using sundials::check_pointer;
+using sundials::Context;
+using sundials::KinsolDeleter;
+using sundials::LinearSolverDeleter;
+using sundials::MatrixDeleter;
+using sundials::VectorDeleter;
 
 struct Problem {
   const std::function<void(const std::vector<double>&, std::vector<double>&)>* F;

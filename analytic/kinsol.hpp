@@ -8,12 +8,12 @@
 #include <string>
 #include <vector>
 
+#include "solver/implicit/sundials.hpp"
+
 namespace mpmvv::analytic {
 
-class SundialsError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+// Thrown when a SUNDIALS call fails or KINSOL cannot converge.
+using SundialsError = sundials::SundialsError;
 
 struct NonlinearSolution {
   std::vector<double> u;
