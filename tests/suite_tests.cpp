@@ -177,6 +177,7 @@ TEST(SuiteRunner, ResumeRunsOnlyWhatIsMissing) {
   EXPECT_EQ(count(read(dir / "out" / "manifest.json"), "kept from an earlier run"), 2);
 }
 
+#ifdef MPMVV_HAVE_MPI
 // Under mpirun the two ranks share the cases and one manifest lists them all.
 TEST(SuiteRunner, MpiRanksShareTheCases) {
   if (shell("command -v mpirun") != 0) GTEST_SKIP() << "mpirun is not installed";
@@ -189,6 +190,7 @@ TEST(SuiteRunner, MpiRanksShareTheCases) {
   EXPECT_EQ(count(manifest, "\"status\": \"completed\""), 3) << manifest;
   EXPECT_TRUE(fs::exists(dir / "out" / "summary.txt"));
 }
+#endif  // MPMVV_HAVE_MPI
 
 namespace {
 

@@ -6,10 +6,10 @@
 #include <numbers>
 
 #include "analytic/hertz.hpp"
+#include "analytic/uniaxial.hpp"
 #include "analytic/vibrating_bar.hpp"
 #ifdef MPMVV_HAVE_SUNDIALS
 #include "analytic/kinsol.hpp"
-#include "analytic/uniaxial.hpp"
 #endif
 
 namespace {
