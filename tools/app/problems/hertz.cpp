@@ -17,6 +17,7 @@
 // beside the axis (read_contact). A finite
 // plate departs from the half-space by terms in (a / D)^2: the default plate
 // is ten half-widths deep, and `plate_depth` takes it deeper.
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <numbers>
@@ -108,12 +109,59 @@ ContactReading read_contact(const GridGeometry& grid, const ContactForces& conta
   return r;
 }
 
+// The stresses below the contact's centre: the particles of the column next
+// to the axis (reference x within a sub-cell of it), by depth z below the
+// surface, against Hertz's sigma_z = -p0 a / sqrt(a^2 + z^2) and
+// sigma_x = -p0 [(a^2 + 2 z^2) / (a sqrt(a^2 + z^2)) - 2 z / a] at the
+// measured load; the largest shear (sigma_x - sigma_z) / 2 and its depth
+// against 0.300 p0 at 0.786 a. Errors: mean |sigma - sigma_Hertz| over
+// 0 < z < 3a, relative to p0.
+struct AxisReading {
+  std::vector<double> depth, sigma_x, sigma_z, exact_x, exact_z;
+  double error_x = 0.0, error_z = 0.0, largest_shear = 0.0, shear_depth = 0.0;
+};
+
+AxisReading read_axis(const Particles& P, double spacing, const analytic::HertzCylinder& hertz) {
+  AxisReading r;
+  std::vector<std::size_t> column;
+  for (std::size_t p = 0; p < P.size(); ++p)
+    if (P.reference_position[p].x() < spacing) column.push_back(p);
+  std::sort(column.begin(), column.end(),
+            [&](std::size_t a, std::size_t b) { return P.position[a].y() > P.position[b].y(); });
+  const double a = hertz.half_width(), p0 = hertz.peak_pressure();
+  int counted = 0;
+  for (std::size_t p : column) {
+    const double z = -P.position[p].y();
+    r.depth.push_back(z);
+    r.sigma_x.push_back(P.stress[p](0, 0));
+    r.sigma_z.push_back(P.stress[p](1, 1));
+    r.exact_x.push_back(hertz.axis_sigma_x(std::max(z, 0.0)));
+    r.exact_z.push_back(hertz.axis_sigma_z(std::max(z, 0.0)));
+    const double shear = 0.5 * (P.stress[p](0, 0) - P.stress[p](1, 1));
+    if (shear > r.largest_shear) {
+      r.largest_shear = shear;
+      r.shear_depth = z;
+    }
+    if (z > 0.0 && z < 3.0 * a) {
+      r.error_x += std::abs(r.sigma_x.back() - r.exact_x.back());
+      r.error_z += std::abs(r.sigma_z.back() - r.exact_z.back());
+      ++counted;
+    }
+  }
+  if (counted > 0 && p0 > 0.0) {
+    r.error_x /= counted * p0;
+    r.error_z /= counted * p0;
+  }
+  return r;
+}
+
 // The pressure profiles at the output times and the load-approach history,
 // gathered during the run and written with the results.
 struct HertzRecord {
   std::vector<double> x;
   std::vector<double> time;
   std::vector<std::vector<double>> pressure, exact_pressure;
+  AxisReading axis;  // at the last output
 };
 
 ProblemSetup setup(const Config& c) {
@@ -165,7 +213,9 @@ ProblemSetup setup(const Config& c) {
   };
 
   auto record = std::make_shared<HertzRecord>();
-  s.extra_error_names = {"error_half_width", "error_peak_pressure", "error_pressure_profile"};
+  const double spacing = h / double(c.integer("particles_per_direction"));
+  s.extra_error_names = {"error_half_width", "error_peak_pressure", "error_pressure_profile", "error_axis_sigma_x",
+                         "error_axis_sigma_z"};
   s.extra_errors = [=](double t, const RunRecord& run) {
     const ContactReading r = read_contact(run.stepper.model().grid, run.stepper.contact_forces(), R, E_star);
     record->x = r.x;
@@ -173,7 +223,8 @@ ProblemSetup setup(const Config& c) {
     record->pressure.push_back(r.pressure);
     record->exact_pressure.push_back(r.exact_pressure);
     const double nan = std::numeric_limits<double>::quiet_NaN();
-    if (!(r.load > 0.0)) return std::vector<double>{nan, nan, nan};
+    if (!(r.load > 0.0)) return std::vector<double>{nan, nan, nan, nan, nan};
+    record->axis = read_axis(run.stepper.model().particles, spacing, r.hertz);
     // Mean |p - p_Hertz| over the columns within 1.5 a, relative to p0.
     double profile = 0.0;
     int columns = 0;
@@ -181,10 +232,13 @@ ProblemSetup setup(const Config& c) {
       profile += std::abs(r.pressure[i] - r.exact_pressure[i]);
     return std::vector<double>{relative_error(r.half_width, r.hertz.half_width()),
                                relative_error(r.peak_pressure, r.hertz.peak_pressure()),
-                               profile / std::max(columns, 1) / r.hertz.peak_pressure()};
+                               profile / std::max(columns, 1) / r.hertz.peak_pressure(), record->axis.error_x,
+                               record->axis.error_z};
   };
   s.measure = [=](const RunRecord& run) -> Measurements {
     const ContactReading r = read_contact(run.stepper.model().grid, run.stepper.contact_forces(), R, E_star);
+    const AxisReading axis = read_axis(run.stepper.model().particles, spacing, r.hertz);
+    const double a = r.hertz.half_width(), p0 = r.hertz.peak_pressure();
     return {{"load", r.load},
             {"approach", delta},
             {"half_width", r.half_width},
@@ -196,6 +250,10 @@ ProblemSetup setup(const Config& c) {
             {"peak_pressure_error", relative_error(r.peak_pressure, r.hertz.peak_pressure())},
             {"peak_pressure_fit", r.fitted_peak},
             {"peak_pressure_fit_error", relative_error(r.fitted_peak, r.hertz.peak_pressure())},
+            {"largest_shear_over_p0", axis.largest_shear / p0},
+            {"largest_shear_over_p0_exact", 0.300},
+            {"largest_shear_depth_over_a", axis.shear_depth / a},
+            {"largest_shear_depth_over_a_exact", 0.786},
             {"half_width_over_h", r.half_width / run.stepper.model().grid.h},
             {"half_width_over_depth", r.half_width / D}};
   };
@@ -215,6 +273,17 @@ ProblemSetup setup(const Config& c) {
     g.write("time", record->time, {T});
     g.write("pressure", p, {T, n});
     g.write("exact_pressure", e, {T, n});
+    h5::Group axis = probes.create_group("axis_stress");
+    axis.set_attribute("description",
+                       "stresses of the particles next to the axis at the last output time, by depth z below the "
+                       "surface, and Hertz's sigma_x, sigma_z on the axis at the measured load [Pa]");
+    const AxisReading& r = record->axis;
+    const std::size_t m = r.depth.size();
+    axis.write("depth", r.depth, {m});
+    axis.write("sigma_x", r.sigma_x, {m});
+    axis.write("sigma_z", r.sigma_z, {m});
+    axis.write("exact_sigma_x", r.exact_x, {m});
+    axis.write("exact_sigma_z", r.exact_z, {m});
   };
   s.history_names = {"approach", "load"};
   s.history = [=](double t, const Stepper& stepper) {
