@@ -119,6 +119,10 @@ struct SceneStages {
   std::vector<NodeConstraint> constraints;  // prescribed motion of grid nodes
   double damping = 0.0;                     // zeta of eq. 1.65 [1/s]; 0: no damping
   std::optional<RigidBody> contact;         // a rigid master in frictionless contact (contact.hpp)
+  // Two deformable bodies in frictionless contact on the grid: particles
+  // [0, second_body) are the first, [second_body, n) the second, each with its
+  // own grid velocity field (contact.hpp). 0: one body.
+  std::size_t second_body = 0;
 };
 
 }  // namespace mpmvv

@@ -47,13 +47,20 @@ class ExplicitStepper final : public Stepper {
         body_force_(std::move(stages.body_force)),
         constraints_(std::move(stages.constraints)),
         damping_(stages.damping),
-        contact_(std::move(stages.contact)) {
+        contact_(std::move(stages.contact)),
+        second_(stages.second_body) {
     buffers_.resize(max_threads(), model_.grid.node_count());
     if (body_force_) {
       body_force_->prepare(model_.particles);
       model_.particles.body_force.assign(model_.particles.size(), Vec2::Zero());
     }
     if (scheme_ == Scheme::musl) next_position_.resize(model_.particles.size());
+    if (second_ > 0) {
+      fields_b_.resize(model_.grid.node_count());
+      gradient_a_.assign(model_.grid.node_count(), Vec2::Zero());
+      gradient_b_.assign(model_.grid.node_count(), Vec2::Zero());
+      gradient_buffers_.resize(std::size_t(max_threads()));
+    }
   }
 
   void step(double t, double dt, double kick) override {
@@ -92,12 +99,50 @@ class ExplicitStepper final : public Stepper {
   // Update stress last (002_c3305cb8b1bc1490.txt section 1.5): forces from the
   // stress at t_n, then velocity, position, F and finally stress.
   void step_usl(double t, double dt, double kick) {
+    if (second_ > 0) {
+      step_usl_two_bodies(t, dt, kick);
+      return;
+    }
     Particles& P = model_.particles;
     const Shape shape = bind(P);
     map_mass_momentum_and_forces(shape, t);
     advance_grid(shape, t, dt, kick);
     move_tracers(dt);
     grid_to_particles<kVelocity | kPosition | kDeformation, Shape>(shape, fields_, P, dt, kick);
+    update_stress<Shape::geometry>(material_, P);
+  }
+
+  // USL for two bodies in contact (contact.hpp): each body maps to its own
+  // grid field, the fields advance apart, the contact corrects them where both
+  // bodies reach a node, and each body reads back its own field.
+  void step_usl_two_bodies(double t, double dt, double kick) {
+    Particles& P = model_.particles;
+    const Shape shape = bind(P);
+    const ParticleRange a{0, second_}, b{second_, P.size()};
+    if (body_force_) evaluate_body_force(t);
+    for (const auto& [range, field] : {std::pair{a, &fields_}, std::pair{b, &fields_b_}}) {
+      if (body_force_)
+        particles_to_grid<kMass | kMomentum | kInternalForce | kBodyForce>(shape, P, buffers_, *field, range);
+      else
+        particles_to_grid<kMass | kMomentum | kInternalForce>(shape, P, buffers_, *field, range);
+    }
+    mass_gradient_to_grid(shape, P, a.first, a.last, gradient_buffers_, gradient_a_);
+    mass_gradient_to_grid(shape, P, b.first, P.size(), gradient_buffers_, gradient_b_);
+    std::vector<double> reactions(constraints_.size(), 0.0);
+    for (GridFields* field : {&fields_, &fields_b_}) {
+      update_grid_motion(*field, kick);
+      if (damping_ > 0.0) damp_grid_motion(*field, damping_, kick);
+      apply_walls(model_.grid, *field);
+      if (!constraints_.empty()) {
+        const std::vector<double> r = apply_constraints(constraints_, t, dt, kick, *field);
+        for (std::size_t k = 0; k < r.size(); ++k) reactions[k] += r[k];
+      }
+    }
+    reactions_ = reactions;
+    apply_body_contact(fields_, fields_b_, gradient_a_, gradient_b_, kick, contact_forces_);
+    move_tracers(dt);
+    grid_to_particles<kVelocity | kPosition | kDeformation, Shape>(shape, fields_, P, dt, kick, nullptr, a);
+    grid_to_particles<kVelocity | kPosition | kDeformation, Shape>(shape, fields_b_, P, dt, kick, nullptr, b);
     update_stress<Shape::geometry>(material_, P);
   }
 
@@ -195,6 +240,10 @@ class ExplicitStepper final : public Stepper {
   double damping_;
   std::optional<RigidBody> contact_;
   ContactScratch contact_scratch_;
+  std::size_t second_;                  // first particle of the second body; 0: one body
+  GridFields fields_b_;                 // the second body's grid field
+  std::vector<Vec2> gradient_a_, gradient_b_;  // mass gradients, eq. 1.107
+  std::vector<std::vector<Vec2>> gradient_buffers_;
   ScatterBuffers buffers_;
   std::vector<Vec2> next_position_;  // MUSL only: x_{n+1} while x_n still sets the weights
   std::vector<Mat2> step_start_deformation_;  // USF with CPDI only: F_n, which sets the domains
@@ -239,6 +288,11 @@ std::unique_ptr<Stepper> make_stepper(Model model, const SolverOptions& options,
   if (!(stages.damping >= 0.0)) throw std::invalid_argument("damping must be zero or positive");
   if (stages.contact && !stages.contact->displacement)
     throw std::invalid_argument("a contact master needs its displacement d(t)");
+  if (stages.second_body > 0) {
+    if (stages.second_body >= n) throw std::invalid_argument("the second body holds no particle");
+    if (options.scheme != Scheme::usl) throw std::invalid_argument("two bodies in contact step with usl only");
+    if (stages.contact) throw std::invalid_argument("two bodies in contact cannot also touch a rigid master");
+  }
   for (const NodeConstraint& c : stages.constraints) {
     if (c.axis != 0 && c.axis != 1) throw std::invalid_argument("a node constraint's axis is 0 (x) or 1 (y)");
     if (!c.displacement) throw std::invalid_argument("a node constraint needs its displacement u(t)");

@@ -10,6 +10,7 @@
 // thread count.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -49,18 +50,26 @@ struct ScatterBuffers {
   }
 };
 
+// A range of particles [first, last): one body of a scene with several, which
+// keep their particles contiguous. The whole set by default.
+struct ParticleRange {
+  std::size_t first = 0;
+  std::size_t last = static_cast<std::size_t>(-1);
+  std::size_t end(const Particles& P) const { return std::min(last, P.size()); }
+};
+
 // Sums the particle quantities selected by `Fields` onto the grid and stores
 // them in `g`, overwriting those node fields (the others are left as they are).
 template <unsigned Fields, class Shape>
 void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& buffers,
-                       GridFields& g) {
+                       GridFields& g, ParticleRange range = {}) {
   constexpr bool with_mass = Fields & kMass;
   constexpr bool with_momentum = Fields & kMomentum;
   constexpr bool with_internal = Fields & kInternalForce;
   constexpr bool with_body = Fields & kBodyForce;
   constexpr bool with_force = with_internal || with_body;
   constexpr bool axisymmetric = Shape::geometry == Geometry::axisymmetric;
-  const std::size_t n = P.size();
+  const std::size_t n = range.end(P);
   const std::size_t nodes = g.mass.size();
   const int threads = int(buffers.per_thread.size());
 
@@ -70,7 +79,7 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
     std::fill(sums, sums + nodes, NodeSums{0.0, 0.0, 0.0, 0.0, 0.0});
     Stencil<Shape::stencil_size> s;
 #pragma omp for schedule(static)
-    for (std::size_t p = 0; p < n; ++p) {
+    for (std::size_t p = range.first; p < n; ++p) {
       shape.evaluate(p, s);
       const double m = P.mass[p];
       Vec2 momentum = Vec2::Zero(), body = Vec2::Zero();
@@ -205,18 +214,18 @@ enum ParticleUpdate : unsigned {
 // stage still needs the old positions, another array.
 template <unsigned Updates, class Shape>
 void grid_to_particles(const Shape& shape, const GridFields& g, Particles& P, double dt, double kick,
-                       Vec2* position_out = nullptr) {
+                       Vec2* position_out = nullptr, ParticleRange range = {}) {
   constexpr bool with_velocity = Updates & kVelocity;
   constexpr bool with_position = Updates & kPosition;
   constexpr bool with_deformation = Updates & kDeformation;
   constexpr bool axisymmetric = Shape::geometry == Geometry::axisymmetric;
   if (position_out == nullptr) position_out = P.position.data();
-  const std::size_t n = P.size();
+  const std::size_t n = range.end(P);
 #pragma omp parallel
   {
     Stencil<Shape::stencil_size> s;
 #pragma omp for schedule(static)
-    for (std::size_t p = 0; p < n; ++p) {
+    for (std::size_t p = range.first; p < n; ++p) {
       shape.evaluate(p, s);
       Vec2 acceleration = Vec2::Zero(), velocity = Vec2::Zero();
       Mat2 L = Mat2::Zero();
