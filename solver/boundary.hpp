@@ -111,6 +111,26 @@ inline void damp_grid_motion(GridFields& g, double zeta, double kick) {
   }
 }
 
+// The damping forces' power over the step, -sum zeta m_g v_g . v_g^L, with
+// v_g^L the velocity after every grid stage, over the components that move
+// freely: a component a constraint prescribes (`fixed`, two flags per node)
+// moves as prescribed whatever force acts on it, and ghost nodes beyond the
+// walls only mirror the nodes inside.
+inline double damping_power(const GridGeometry& grid, const GridFields& g, double zeta,
+                            const std::vector<unsigned char>& fixed) {
+  double power = 0.0;
+  const int nx = grid.nodes_x(), ny = grid.nodes_y(), ghost = grid.ghost_layers;
+#pragma omp parallel for schedule(static) reduction(+ : power)
+  for (int j = ghost; j < ny - ghost; ++j)
+    for (int i = ghost; i < nx - ghost; ++i) {
+      const std::size_t node = std::size_t(grid.node(i, j));
+      if (!(g.mass[node] > 0.0)) continue;
+      for (int a = 0; a < 2; ++a)
+        if (!fixed[2 * node + std::size_t(a)]) power -= zeta * g.momentum[node][a] * g.velocity[node][a];
+    }
+  return power;
+}
+
 // ---------------------------------------------------------------- what a scene adds
 
 // The optional stages of a scene's step; what it leaves empty is absent.

@@ -9,6 +9,7 @@
 #include "shape/cpdi.hpp"
 #include "shape/gimp.hpp"
 #include "shape/linear.hpp"
+#include "monitors.hpp"
 
 namespace mpmvv {
 
@@ -55,6 +56,11 @@ class ExplicitStepper final : public Stepper {
       model_.particles.body_force.assign(model_.particles.size(), Vec2::Zero());
     }
     if (scheme_ == Scheme::musl) next_position_.resize(model_.particles.size());
+    if (damping_ > 0.0) {
+      fixed_components_.assign(2 * model_.grid.node_count(), 0);
+      for (const NodeConstraint& c : constraints_)
+        for (std::size_t node : c.nodes) fixed_components_[2 * node + std::size_t(c.axis)] = 1;
+    }
     if (second_ > 0) {
       fields_b_.resize(model_.grid.node_count());
       gradient_a_.assign(model_.grid.node_count(), Vec2::Zero());
@@ -73,6 +79,10 @@ class ExplicitStepper final : public Stepper {
 
   ParticleScan scan() const override {
     return scan_particles(bind(model_.particles), material_, model_.particles);
+  }
+
+  Monitors monitors() const override {
+    return monitor_particles(bind(model_.particles), material_, model_.particles, model_.grid);
   }
 
   ParticleFault diagnose(std::size_t p) const override {
@@ -110,6 +120,7 @@ class ExplicitStepper final : public Stepper {
     move_tracers(dt);
     grid_to_particles<kVelocity | kPosition | kDeformation, Shape>(shape, fields_, P, dt, kick);
     update_stress<Shape::geometry>(material_, P);
+    book_body_work(dt);
   }
 
   // USL for two bodies in contact (contact.hpp): each body maps to its own
@@ -137,13 +148,16 @@ class ExplicitStepper final : public Stepper {
         const std::vector<double> r = apply_constraints(constraints_, t, dt, kick, *field);
         for (std::size_t k = 0; k < r.size(); ++k) reactions[k] += r[k];
       }
+      if (damping_ > 0.0) ledger_.damping += dt * damping_power(model_.grid, *field, damping_, fixed_components_);
     }
     reactions_ = reactions;
+    if (!constraints_.empty()) book_constraint_work(t, dt);
     apply_body_contact(fields_, fields_b_, gradient_a_, gradient_b_, kick, contact_forces_);
     move_tracers(dt);
     grid_to_particles<kVelocity | kPosition | kDeformation, Shape>(shape, fields_, P, dt, kick, nullptr, a);
     grid_to_particles<kVelocity | kPosition | kDeformation, Shape>(shape, fields_b_, P, dt, kick, nullptr, b);
     update_stress<Shape::geometry>(material_, P);
+    book_body_work(dt);
   }
 
   // Update stress first: F and stress from the grid velocity at t_n, then the
@@ -174,6 +188,7 @@ class ExplicitStepper final : public Stepper {
     advance_grid(shape, t, dt, kick);
     move_tracers(dt);
     grid_to_particles<kVelocity | kPosition, Shape>(shape, fields_, P, dt, kick);
+    book_body_work(dt);
   }
 
   // Modified USL: as USL, but the velocity gradient comes from the particle
@@ -192,6 +207,7 @@ class ExplicitStepper final : public Stepper {
     grid_to_particles<kDeformation, Shape>(shape, fields_, P, dt, kick);
     P.position.swap(next_position_);
     update_stress<Shape::geometry>(material_, P);
+    book_body_work(dt);
   }
 
   Shape bind(const Particles& P, const Mat2* domain_deformation = nullptr) const {
@@ -216,10 +232,37 @@ class ExplicitStepper final : public Stepper {
     update_grid_motion(fields_, kick);
     if (damping_ > 0.0) damp_grid_motion(fields_, damping_, kick);
     apply_walls(model_.grid, fields_);
-    if (!constraints_.empty()) reactions_ = apply_constraints(constraints_, t, dt, kick, fields_);
-    if (contact_)
+    if (!constraints_.empty()) {
+      reactions_ = apply_constraints(constraints_, t, dt, kick, fields_);
+      book_constraint_work(t, dt);
+    }
+    if (contact_) {
       apply_rigid_contact(*contact_, shape, model_.particles, model_.grid, fields_, t, dt, kick, contact_scratch_,
                           contact_forces_);
+      for (std::size_t i = 0; i < contact_forces_.node_force.size(); ++i)
+        if (contact_forces_.node_force[i].x() != 0.0 || contact_forces_.node_force[i].y() != 0.0)
+          ledger_.contact += dt * contact_forces_.node_force[i].dot(fields_.velocity[i]);
+    }
+    if (damping_ > 0.0) ledger_.damping += dt * damping_power(model_.grid, fields_, damping_, fixed_components_);
+  }
+
+  // Each constraint's reaction does work along its prescribed increment.
+  void book_constraint_work(double t, double dt) {
+    for (std::size_t k = 0; k < constraints_.size(); ++k)
+      ledger_.constraints +=
+          reactions_[k] * (constraints_[k].displacement(t + dt) - constraints_[k].displacement(t));
+  }
+
+  // The body force's work over the step, sum m b . v dt with v the velocity
+  // the particles carry over it.
+  void book_body_work(double dt) {
+    if (!body_force_) return;
+    const Particles& P = model_.particles;
+    const std::size_t n = P.size();
+    double work = 0.0;
+#pragma omp parallel for schedule(static) reduction(+ : work)
+    for (std::size_t p = 0; p < n; ++p) work += P.mass[p] * P.body_force[p].dot(P.velocity[p]);
+    ledger_.body += dt * work;
   }
 
   void evaluate_body_force(double t) {
@@ -238,6 +281,7 @@ class ExplicitStepper final : public Stepper {
   std::shared_ptr<BodyForce> body_force_;
   std::vector<NodeConstraint> constraints_;
   double damping_;
+  std::vector<unsigned char> fixed_components_;  // with damping: the components constraints prescribe
   std::optional<RigidBody> contact_;
   ContactScratch contact_scratch_;
   std::size_t second_;                  // first particle of the second body; 0: one body

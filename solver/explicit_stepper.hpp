@@ -11,6 +11,7 @@
 
 #include "boundary.hpp"
 #include "model.hpp"
+#include "monitors.hpp"
 
 namespace mpmvv {
 
@@ -48,6 +49,9 @@ class Stepper {
   virtual std::string step_failure() const { return {}; }
   // Counters of the stepper's own (Newton and Krylov iterations), for the results file.
   virtual std::vector<std::pair<std::string, double>> statistics() const { return {}; }
+  // The run's health now (monitors.hpp), and the work done on it so far.
+  virtual Monitors monitors() const = 0;
+  const EnergyLedger& ledger() const { return ledger_; }
 
  protected:
   explicit Stepper(Model model) : model_(std::move(model)) { fields_.resize(model_.grid.node_count()); }
@@ -56,6 +60,7 @@ class Stepper {
   double forcing_seconds_ = 0.0;
   std::vector<double> reactions_;
   ContactForces contact_forces_;
+  EnergyLedger ledger_;
 };
 
 // Checks the particles carry what the method needs, then picks the stepper

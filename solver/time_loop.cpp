@@ -104,6 +104,13 @@ RunOutcome run_time_loop(Stepper& stepper, const TimeLoopOptions& options, RunOb
       observer.at_output(next_output, t, stepper);
       ++next_output;
       out.outputs_written = next_output;
+      if (const auto [reason, detail] = observer.stop(); !reason.empty()) {
+        out.failure_reason = reason;
+        out.failure_detail = detail;
+        out.failure_time = t;
+        out.failure_step = out.steps;
+        break;
+      }
     }
 
     if (progress && seconds_since(last_report) >= progress_interval_seconds) {

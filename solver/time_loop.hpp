@@ -7,6 +7,7 @@
 #include <functional>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "explicit_stepper.hpp"
@@ -63,6 +64,9 @@ class RunObserver {
   virtual void initial(const Stepper&) {}
   virtual void after_step(double /*t*/, const Stepper&) {}
   virtual void at_output(std::size_t /*index*/, double /*t*/, const Stepper&) {}
+  // After an output: a reason to stop the run there (and its detail), when
+  // the observer has one (an energy blow-up); empty to go on.
+  virtual std::pair<std::string, std::string> stop() const { return {}; }
 };
 
 struct Progress {

@@ -253,3 +253,37 @@ TEST(MooneyRivlin, WaveModulusBoundsTheAcousticTensorUnderCompression) {
 }
 
 }  // namespace
+
+// The stored energy of each hyperelastic material is zero at F = I and its
+// derivative is the first Piola stress J sigma F^-T (in-plane block, central
+// differences of psi at random F, plane strain and with an out-of-plane
+// stretch): the energy monitors count the work the stress does.
+TEST(StoredEnergy, VanishesAtRestAndDifferentiatesToTheStress) {
+  const mpmvv::NeoHookean neo{577.0, 385.0};
+  const mpmvv::MooneyRivlin mooney{150.0, 40.0, 850.0};
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> d(-0.3, 0.3);
+  auto check = [&](const auto& material, const char* name) {
+    EXPECT_NEAR(material.energy_density(mpmvv::Mat2::Identity(), 1.0), 0.0, 1e-12) << name;
+    for (int k = 0; k < 50; ++k) {
+      mpmvv::Mat2 F;
+      F << 1.0 + d(rng), d(rng), d(rng), 1.0 + d(rng);
+      const double F33 = k % 2 ? 1.0 : 1.0 + 0.5 * d(rng);
+      const auto s = material.stress(F, F33);
+      const double J = mpmvv::determinant(F) * F33;
+      const mpmvv::Mat2 P = J * s.in_plane * mpmvv::inverse(F).transpose();
+      const double step = 1e-6;
+      for (int i = 0; i < 2; ++i)
+        for (int j = 0; j < 2; ++j) {
+          mpmvv::Mat2 up = F, down = F;
+          up(i, j) += step;
+          down(i, j) -= step;
+          const double derivative =
+              (material.energy_density(up, F33) - material.energy_density(down, F33)) / (2.0 * step);
+          EXPECT_NEAR(derivative, P(i, j), 1e-6 * (1.0 + P.norm())) << name << " F = " << F << " F33 = " << F33;
+        }
+    }
+  };
+  check(neo, "neo-hookean");
+  check(mooney, "mooney-rivlin");
+}

@@ -467,6 +467,7 @@ class RecordingStepper final : public Stepper {
   }
   mpmvv::ParticleScan scan() const override { return inner_->scan(); }
   mpmvv::ParticleFault diagnose(std::size_t p) const override { return inner_->diagnose(p); }
+  mpmvv::Monitors monitors() const override { return inner_->monitors(); }
 
   std::vector<Call> calls;
 

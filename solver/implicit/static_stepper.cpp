@@ -15,6 +15,7 @@
 #include "solver/shape/cpdi.hpp"
 #include "solver/shape/gimp.hpp"
 #include "solver/shape/linear.hpp"
+#include "solver/monitors.hpp"
 #include "solver/stages.hpp"
 
 namespace mpmvv {
@@ -112,6 +113,10 @@ class StaticStepper final : public Stepper {
 
   ParticleScan scan() const override {
     return scan_particles(Shape::bind(model_.grid, model_.particles), material_, model_.particles);
+  }
+
+  Monitors monitors() const override {
+    return monitor_particles(Shape::bind(model_.grid, model_.particles), material_, model_.particles, model_.grid);
   }
 
   ParticleFault diagnose(std::size_t p) const override {
@@ -383,13 +388,33 @@ class StaticStepper final : public Stepper {
   void finish(const Shape& shape, const std::vector<double>& q, double dt) {
     residual_at(shape, q);  // u_ and fields_.force at the solution
     Particles& P = model_.particles;
+    // Work of the loads over the increment, by the trapezoid rule between the
+    // loads at the step's start and end (energy ledger, monitors.hpp).
+    const std::vector<double> previous_reactions = reactions_;
     reactions_.clear();
-    for (const NodeConstraint& c : constraints_) {
+    for (std::size_t k = 0; k < constraints_.size(); ++k) {
+      const NodeConstraint& c = constraints_[k];
       double reaction = 0.0;
       for (std::size_t node : c.nodes) reaction -= fields_.force[node][c.axis];
       reactions_.push_back(reaction);
+      const double before = k < previous_reactions.size() ? previous_reactions[k] : 0.0;
+      ledger_.constraints += 0.5 * (before + reaction) * (c.displacement(time_ + dt) - c.displacement(time_));
+    }
+    if (body_force_) {
+      double work = 0.0;
+      Stencil<Shape::stencil_size> s;
+      for (std::size_t p = 0; p < P.size(); ++p) {
+        shape.evaluate(p, s);
+        Vec2 move = Vec2::Zero();
+        for (int k = 0; k < Shape::stencil_size; ++k) move += s.weight[k] * u_[std::size_t(s.node[k])];
+        const Vec2 before = previous_body_force_.empty() ? Vec2::Zero() : previous_body_force_[p];
+        work += P.mass[p] * 0.5 * (before + P.body_force[p]).dot(move);
+      }
+      ledger_.body += work;
+      previous_body_force_ = P.body_force;
     }
     if (contact_) {
+      const std::vector<Vec2> previous = contact_forces_.node_force;
       contact_forces_.node_force.assign(model_.grid.node_count(), Vec2::Zero());
       contact_forces_.total.setZero();
       for (std::size_t i = 0; i < active_.size(); ++i)
@@ -397,6 +422,10 @@ class StaticStepper final : public Stepper {
           contact_forces_.node_force[i] = -fields_.force[i];
           contact_forces_.total += contact_forces_.node_force[i];
         }
+      for (std::size_t i = 0; i < contact_forces_.node_force.size(); ++i) {
+        const Vec2 before = i < previous.size() ? previous[i] : Vec2::Zero();
+        ledger_.contact += 0.5 * (before + contact_forces_.node_force[i]).dot(u_[i]);
+      }
     }
     // Tracers move with the grid's displacement, as in the explicit step
     // (mass-weighted, stages.hpp).
@@ -422,7 +451,7 @@ class StaticStepper final : public Stepper {
         P.volume[p] = determinant(P.deformation_gradient[p]) * P.reference_volume[p];
         P.stress[p] = material_.cauchy_stress(P.deformation_gradient[p]);
         P.position[p] += move;
-        P.velocity[p] = move / dt;
+        P.velocity[p].setZero();  // quasi-static: no inertia, no kinetic energy
       }
     }
   }
@@ -438,6 +467,7 @@ class StaticStepper final : public Stepper {
 
   ScatterBuffers buffers_;
   std::vector<Mat2> deformation_n_;
+  std::vector<Vec2> previous_body_force_;
   std::vector<NodeMap> map_;
   int dofs_ = 0;
   std::vector<Vec2> u_;

@@ -29,6 +29,14 @@ struct LinearElastic {
     return stress(F, T(1.0)).in_plane;
   }
 
+  // Stored energy per reference volume, lambda/2 (tr eps)^2 + mu eps:eps.
+  double energy_density(const Mat2& F, double F33) const {
+    const Mat2 eps = 0.5 * (F + F.transpose()) - Mat2::Identity();
+    const double eps33 = F33 - 1.0;
+    const double trace = eps.trace() + eps33;
+    return 0.5 * lambda * trace * trace + mu * (eps.squaredNorm() + eps33 * eps33);
+  }
+
   double p_wave_modulus() const { return lambda + 2.0 * mu; }
   // The small-strain Lame constants (lambda, mu).
   SmallStrainModuli small_strain_moduli() const { return {lambda, mu}; }

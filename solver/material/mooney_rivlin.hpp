@@ -48,6 +48,18 @@ struct MooneyRivlin {
     return stress(F, T(1.0)).in_plane;
   }
 
+  // Stored energy per reference volume, W above.
+  double energy_density(const Mat2& F, double F33) const {
+    const double J = determinant(F) * F33;
+    const Mat2 B = F * F.transpose();
+    const double b33 = F33 * F33;
+    const double j23 = std::pow(J, -2.0 / 3.0);
+    const double i1_bar = j23 * (B.trace() + b33);
+    const double i2_bar = j23 * j23 * (determinant(B) + B.trace() * b33);
+    const double lnJ = std::log(J);
+    return c1 * (i1_bar - 3.0) + c2 * (i2_bar - 3.0) + 0.5 * bulk_modulus * lnJ * lnJ;
+  }
+
   double shear_modulus() const { return 2.0 * (c1 + c2); }
   double p_wave_modulus() const { return bulk_modulus + 4.0 / 3.0 * shear_modulus(); }
   // The small-strain Lame constants: mu = 2 (C1 + C2), lambda = K - 2 mu / 3.

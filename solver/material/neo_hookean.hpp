@@ -35,6 +35,15 @@ struct NeoHookean {
     return stress(F, T(1.0)).in_plane;
   }
 
+  // Stored energy per reference volume, psi = mu/2 (I1 - 3) - mu ln J +
+  // lambda/2 (ln J)^2, whose Kirchhoff stress is the stress above.
+  double energy_density(const Mat2& F, double F33) const {
+    const double J = determinant(F) * F33;
+    const double I1 = (F * F.transpose()).trace() + F33 * F33;
+    const double lnJ = std::log(J);
+    return 0.5 * mu * (I1 - 3.0) - mu * lnJ + 0.5 * lambda * lnJ * lnJ;
+  }
+
   // Small-strain P-wave modulus lambda + 2 mu.
   double p_wave_modulus() const { return lambda + 2.0 * mu; }
   // The small-strain Lame constants (lambda, mu).

@@ -5,6 +5,7 @@
 #include "solver/implicit/static_stepper.hpp"
 #endif
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -178,6 +179,11 @@ class MmsCase final : public SceneCase, private RunObserver {
     Measurements m;
     if (setup_.measure) m = setup_.measure(RunRecord{point_time_, point_simulated_, *stepper_});
     for (const auto& s : stepper_->statistics()) m.push_back(s);
+    if (!monitor_rows_.empty()) {
+      // The energy balance at the last output (see record_monitors).
+      m.push_back({"energy_created", monitor_rows_.back().created});
+      m.push_back({"energy_scale", largest_energy_});
+    }
     return m;
   }
   std::string seeding() const override { return exact_seeding_ ? "exact" : "centre"; }
@@ -257,6 +263,37 @@ class MmsCase final : public SceneCase, private RunObserver {
         g.write(setup_.history_names[k], history_values_[k], {history_values_[k].size()});
     }
     if (setup_.write_extra) setup_.write_extra(probes);
+    write_monitors(probes);
+  }
+
+  void write_monitors(h5::Group& probes) const {
+    h5::Group g = probes.create_group("monitors");
+    g.set_attribute("description",
+                    "the run's health at each output time (solver/monitors.hpp): kinetic and strain energy, the work "
+                    "done on the particles by body forces and tractions, node constraints, contact and damping, the "
+                    "energy made from nothing (kinetic + strain - initial - work), J's range, the largest particle "
+                    "speed over its wave speed, the largest CPDI domain distortion (1: square), particles at the "
+                    "grid's edge [J per unit depth; per radian in r-z]");
+    g.set_attribute("initial_energy", initial_energy_);
+    const std::size_t n = monitor_rows_.size();
+    auto column = [&](const char* name, auto get) {
+      std::vector<double> v;
+      for (const MonitorRow& r : monitor_rows_) v.push_back(get(r));
+      g.write(name, v, {n});
+    };
+    column("time", [](const MonitorRow& r) { return r.time; });
+    column("kinetic_energy", [](const MonitorRow& r) { return r.monitors.kinetic; });
+    column("strain_energy", [](const MonitorRow& r) { return r.monitors.strain; });
+    column("work_body_force", [](const MonitorRow& r) { return r.work.body; });
+    column("work_constraints", [](const MonitorRow& r) { return r.work.constraints; });
+    column("work_contact", [](const MonitorRow& r) { return r.work.contact; });
+    column("work_damping", [](const MonitorRow& r) { return r.work.damping; });
+    column("energy_created", [](const MonitorRow& r) { return r.created; });
+    column("min_J", [](const MonitorRow& r) { return r.monitors.min_J; });
+    column("max_J", [](const MonitorRow& r) { return r.monitors.max_J; });
+    column("max_speed_over_wave_speed", [](const MonitorRow& r) { return r.monitors.max_mach; });
+    column("max_domain_distortion", [](const MonitorRow& r) { return r.monitors.max_distortion; });
+    column("particles_near_edge", [](const MonitorRow& r) { return double(r.monitors.near_edge); });
   }
 
  private:
@@ -419,6 +456,38 @@ class MmsCase final : public SceneCase, private RunObserver {
     return probe_value(q, setup_.geometry, x, X, x);
   }
 
+  // The energy at the start, for the balance (monitors.hpp).
+  void initial(const Stepper& s) override {
+    const Monitors m = s.monitors();
+    initial_energy_ = m.kinetic + m.strain;
+    largest_energy_ = initial_energy_;
+    monitor_rows_.clear();
+    stop_ = {};
+  }
+
+  std::pair<std::string, std::string> stop() const override { return stop_; }
+
+  // Monitors at an output time, and the energy balance: what the run made
+  // from nothing, E - E_0 - W (W the work done on it), against the larger of
+  // the energy it started with and the largest work done on it so far.
+  void record_monitors(double t, const Stepper& s) {
+    const Monitors m = s.monitors();
+    const EnergyLedger& w = s.ledger();
+    const double energy = m.kinetic + m.strain;
+    const double created = energy - initial_energy_ - w.total();
+    // The scale: the energy at the start and the largest work yet done on the
+    // run by any one agent (not the energy now, which a blow-up inflates).
+    largest_energy_ = std::max({largest_energy_, std::abs(w.body), std::abs(w.constraints), std::abs(w.contact),
+                                std::abs(w.damping)});
+    monitor_rows_.push_back({t, m, w, created});
+    const double factor = config_.real("energy_blowup_factor");
+    if (created > factor * largest_energy_ && created > 0.0)
+      stop_ = {"energy blow-up",
+               fmt::format("at t = {:.6g} s the run made {:.4g} J of energy from nothing, {:.3g} times the {:.4g} J it "
+                           "started with or was given (energy_blowup_factor = {})",
+                           t, created, created / largest_energy_, largest_energy_, factor)};
+  }
+
   void after_step(double t, const Stepper& s) override {
     if (setup_.history) {
       const std::vector<double> values = setup_.history(t, s);
@@ -434,6 +503,7 @@ class MmsCase final : public SceneCase, private RunObserver {
   }
 
   void at_output(std::size_t, double t, const Stepper& s) override {
+    record_monitors(t, s);
     const std::vector<Vec2>& tracers = s.model().tracers;
     output_times_.push_back(t);
     errors_.time.push_back(t);
@@ -514,6 +584,15 @@ class MmsCase final : public SceneCase, private RunObserver {
   std::vector<double> output_times_;
   std::vector<double> history_time_;
   std::vector<std::vector<double>> history_values_;
+  struct MonitorRow {
+    double time;
+    Monitors monitors;
+    EnergyLedger work;
+    double created;
+  };
+  std::vector<MonitorRow> monitor_rows_;
+  double initial_energy_ = 0.0, largest_energy_ = 0.0;
+  std::pair<std::string, std::string> stop_;
   ErrorTable errors_;
 };
 

@@ -52,6 +52,11 @@ std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_
       {"output_times", KeyKind::real_list, std::move(default_output_times),
        "times at which probes and errors are recorded [s]; later than end_time are dropped, end_time is always one",
        0.0, inf, true},
+      {"energy_blowup_factor", KeyKind::real, 10.0,
+       "at an output time the run stops with 'energy blow-up' when the energy it made from nothing (kinetic plus "
+       "strain energy less their start, less the work done on it) exceeds this factor times the larger of the energy "
+       "it started with and the largest work done on it",
+       0.0, inf, true},
   };
 }
 

@@ -1,0 +1,86 @@
+// What a run's health is read from, at every output time: energies, the range
+// of J, how fast particles move against the waves, how distorted the CPDI
+// domains are, and how many particles sit at the grid's edge. One pass over
+// the particles; a stepper calls it with its own shape and material.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+
+#include "grid.hpp"
+#include "particles.hpp"
+#include "shape/stencil.hpp"
+#include "stages.hpp"
+
+namespace mpmvv {
+
+// Work done on the particles since t = 0 by what the scene adds [J per unit
+// depth; per radian in r-z]: body forces and tractions (sum m b.v dt), node
+// constraints (reaction times prescribed increment), contact (sum f.v dt at
+// the nodes in contact) and grid damping (negative).
+struct EnergyLedger {
+  double body = 0.0, constraints = 0.0, contact = 0.0, damping = 0.0;
+  double total() const { return body + constraints + contact + damping; }
+};
+
+struct Monitors {
+  double kinetic = 0.0;        // sum m |v|^2 / 2
+  double strain = 0.0;         // sum V0 psi(F)
+  double min_J = std::numeric_limits<double>::infinity();
+  double max_J = 0.0;
+  double max_mach = 0.0;       // max |v_p| / c_p, c_p the material's wave speed at the particle's state
+  // max over particles of (|r1|^2 + |r2|^2) / (2 |r1 x r2|) for the domain
+  // half-vectors: 1 for a square, growing as a domain shears or stretches
+  // (NaN without domains: linear MPM).
+  double max_distortion = std::numeric_limits<double>::quiet_NaN();
+  std::size_t near_edge = 0;   // particles whose domain reaches past the middle of the grid's outermost cell layer
+};
+
+template <class Shape, class Material>
+Monitors monitor_particles(const Shape& shape, const Material& material, const Particles& P,
+                           const GridGeometry& grid) {
+  Monitors m;
+  const std::size_t n = P.size();
+  double kinetic = 0.0, strain = 0.0, min_J = m.min_J, max_J = 0.0, mach = 0.0;
+  double distortion = 0.0;
+  std::size_t near = 0;
+  constexpr bool has_domain = !std::is_same_v<Shape, LinearShapeT<Shape::geometry>>;
+#pragma omp parallel for schedule(static) reduction(+ : kinetic, strain, near) reduction(min : min_J) \
+    reduction(max : max_J, mach, distortion)
+  for (std::size_t p = 0; p < n; ++p) {
+    const double F33 = out_of_plane_stretch<Shape::geometry>(P, p);
+    const double J = determinant(P.deformation_gradient[p]) * F33;
+    kinetic += 0.5 * P.mass[p] * P.velocity[p].squaredNorm();
+    strain += P.reference_volume[p] * material.energy_density(P.deformation_gradient[p], F33);
+    min_J = std::min(min_J, J);
+    max_J = std::max(max_J, J);
+    const double c = std::sqrt(material.wave_modulus(P.deformation_gradient[p], F33, P.stress[p]) /
+                               (P.mass[p] / P.volume[p]));
+    mach = std::max(mach, P.velocity[p].norm() / c);
+    const Mat2 s = shape.domain(p);
+    if constexpr (has_domain) {
+      const double area = std::abs(determinant(s));
+      distortion = std::max(distortion, area > 0.0 ? s.squaredNorm() / (2.0 * area)
+                                                   : std::numeric_limits<double>::infinity());
+    }
+    bool edge = false;
+    for (const double a : {-1.0, 1.0})
+      for (const double b : {-1.0, 1.0}) {
+        const Vec2 xi = grid_coordinate(grid, P.position[p] + a * s.col(0) + b * s.col(1));
+        edge = edge || !(xi.x() >= 0.5 && xi.y() >= 0.5 && xi.x() <= grid.cells_x - 0.5 && xi.y() <= grid.cells_y - 0.5);
+      }
+    if (edge) ++near;
+  }
+  m.kinetic = kinetic;
+  m.strain = strain;
+  m.min_J = min_J;
+  m.max_J = max_J;
+  m.max_mach = mach;
+  if constexpr (has_domain) m.max_distortion = distortion;
+  m.near_edge = near;
+  return m;
+}
+
+}  // namespace mpmvv
