@@ -40,10 +40,12 @@ namespace {
 template <class Shape, class Material>
 class ExplicitStepper final : public Stepper {
  public:
-  ExplicitStepper(Model model, Scheme scheme, Material material, SceneStages stages, double gradient_scale)
+  ExplicitStepper(Model model, Scheme scheme, Material material, SceneStages stages, double gradient_scale,
+                  bool cell_averaged)
       : Stepper(std::move(model)),
         scheme_(scheme),
         gradient_scale_(gradient_scale),
+        cell_averaged_(cell_averaged),
         material_(material),
         body_force_(std::move(stages.body_force)),
         constraints_(std::move(stages.constraints)),
@@ -56,6 +58,7 @@ class ExplicitStepper final : public Stepper {
       model_.particles.body_force.assign(model_.particles.size(), Vec2::Zero());
     }
     if (scheme_ == Scheme::musl) next_position_.resize(model_.particles.size());
+    if (cell_averaged_) cell_volume_.resize(std::size_t(max_threads()));
     if (damping_ > 0.0) {
       fixed_components_.assign(2 * model_.grid.node_count(), 0);
       for (const NodeConstraint& c : constraints_)
@@ -119,7 +122,7 @@ class ExplicitStepper final : public Stepper {
     advance_grid(shape, t, dt, kick);
     move_tracers(dt);
     grid_to_particles<kVelocity | kPosition | kDeformation, Shape>(shape, fields_, P, dt, kick);
-    update_stress<Shape::geometry>(material_, P);
+    update_stress_of_particles();
     book_body_work(dt);
   }
 
@@ -156,7 +159,7 @@ class ExplicitStepper final : public Stepper {
     move_tracers(dt);
     grid_to_particles<kVelocity | kPosition | kDeformation, Shape>(shape, fields_, P, dt, kick, nullptr, a);
     grid_to_particles<kVelocity | kPosition | kDeformation, Shape>(shape, fields_b_, P, dt, kick, nullptr, b);
-    update_stress<Shape::geometry>(material_, P);
+    update_stress_of_particles();
     book_body_work(dt);
   }
 
@@ -178,7 +181,7 @@ class ExplicitStepper final : public Stepper {
     apply_walls(model_.grid, fields_);
     if (!constraints_.empty()) apply_constraints(constraints_, t, dt, kick, fields_);
     grid_to_particles<kDeformation, Shape>(shape, fields_, P, dt, kick);
-    update_stress<Shape::geometry>(material_, P);
+    update_stress_of_particles();
     if (body_force_) {
       evaluate_body_force(t);
       particles_to_grid<kInternalForce | kBodyForce>(shape, P, buffers_, fields_);
@@ -206,7 +209,7 @@ class ExplicitStepper final : public Stepper {
     if (!constraints_.empty()) apply_constraints(constraints_, t, dt, kick, fields_);
     grid_to_particles<kDeformation, Shape>(shape, fields_, P, dt, kick);
     P.position.swap(next_position_);
-    update_stress<Shape::geometry>(material_, P);
+    update_stress_of_particles();
     book_body_work(dt);
   }
 
@@ -222,6 +225,13 @@ class ExplicitStepper final : public Stepper {
     } else {
       particles_to_grid<kMass | kMomentum | kInternalForce>(shape, P, buffers_, fields_);
     }
+  }
+
+  // The constitutive update, after the locking remedy when the run has it.
+  void update_stress_of_particles() {
+    Particles& P = model_.particles;
+    if (cell_averaged_) average_cell_dilatation<Shape::geometry>(model_.grid, P, cell_volume_);
+    update_stress<Shape::geometry>(material_, P);
   }
 
   // a_g and v_g^L from the node sums (eqs. 1.71-1.72), with the scene's damping
@@ -277,6 +287,8 @@ class ExplicitStepper final : public Stepper {
 
   Scheme scheme_;
   double gradient_scale_;
+  bool cell_averaged_;
+  std::vector<std::vector<double>> cell_volume_;  // locking remedy: per-thread cell volume sums
   Material material_;
   std::shared_ptr<BodyForce> body_force_;
   std::vector<NodeConstraint> constraints_;
@@ -300,7 +312,7 @@ std::unique_ptr<Stepper> make_for_shape(Model model, const SolverOptions& o, con
       [&](const auto& m) -> std::unique_ptr<Stepper> {
         using Material = std::decay_t<decltype(m)>;
         return std::make_unique<ExplicitStepper<Shape, Material>>(std::move(model), o.scheme, m, std::move(stages),
-                                                                 o.cpdi_gradient_scale);
+                                                                 o.cpdi_gradient_scale, o.cell_averaged_dilatation);
       },
       material);
 }

@@ -34,6 +34,9 @@ struct SolverOptions {
   // (MPMVV_FAULT=cpdi-gradient): the CPDI gradients are scaled by this factor.
   // 1 in every real run.
   double cpdi_gradient_scale = 1.0;
+  // Volumetric locking remedy (002_c3305cb8b1bc1490.txt eqs. 1.82-1.84): after
+  // each deformation update every particle takes its cell's mean dilatation.
+  bool cell_averaged_dilatation = false;
 };
 
 // A body force supplied by the scene, per unit mass. One call fills the whole

@@ -252,6 +252,57 @@ void grid_to_particles(const Shape& shape, const GridFields& g, Particles& P, do
   }
 }
 
+// ---------------------------------------------------------------- locking remedy
+
+// The cell-averaged dilatation of 002_c3305cb8b1bc1490.txt eqs. 1.82-1.84: in
+// each cell c (by the particles' centres), V_c0 = sum V_p0 and V_c = sum V_p
+// give J_c = V_c / V_c0 (eqs. 1.82-1.83), and each particle's F is scaled to
+// that dilatation, F_p <- (J_c / J_p)^(1/d) F_p (eq. 1.84 with d = 3; here
+// d = 2 for the in-plane block, and in r-z the hoop stretch takes its share:
+// d = 3 over (F_inplane, F_theta)), with V_p = J_c V_p0. It relaxes the
+// volumetric constraint to one per cell, which is what unlocks a nearly
+// incompressible material. `cell_volume` holds two sums per cell, per thread.
+template <Geometry G>
+void average_cell_dilatation(const GridGeometry& grid, Particles& P, std::vector<std::vector<double>>& cell_volume) {
+  const std::size_t n = P.size();
+  const std::size_t cells = std::size_t(grid.cells_x) * std::size_t(grid.cells_y);
+  const int threads = int(cell_volume.size());
+  auto cell_of = [&](std::size_t p) {
+    const Vec2 xi = grid_coordinate(grid, P.position[p]);
+    return std::size_t(cell_index(std::max(xi.y(), 0.0), grid.cells_y)) * std::size_t(grid.cells_x) +
+           std::size_t(cell_index(std::max(xi.x(), 0.0), grid.cells_x));
+  };
+#pragma omp parallel num_threads(threads)
+  {
+    std::vector<double>& own = cell_volume[std::size_t(thread_id())];
+    own.assign(2 * cells, 0.0);
+#pragma omp for schedule(static)
+    for (std::size_t p = 0; p < n; ++p) {
+      const std::size_t c = cell_of(p);
+      own[2 * c] += P.reference_volume[p];
+      own[2 * c + 1] += P.volume[p];
+    }
+#pragma omp for schedule(static)
+    for (std::size_t c = 0; c < 2 * cells; ++c)
+      for (int t = 1; t < threads; ++t) cell_volume[0][c] += cell_volume[std::size_t(t)][c];
+#pragma omp for schedule(static)
+    for (std::size_t p = 0; p < n; ++p) {
+      const std::size_t c = cell_of(p);
+      const double J_cell = cell_volume[0][2 * c + 1] / cell_volume[0][2 * c];
+      const double J = P.volume[p] / P.reference_volume[p];
+      if (!(J > 0.0 && J_cell > 0.0)) continue;  // the health scan reports it
+      if constexpr (G == Geometry::axisymmetric) {
+        const double scale = std::cbrt(J_cell / J);
+        P.deformation_gradient[p] *= scale;
+        P.hoop_stretch[p] *= scale;
+      } else {
+        P.deformation_gradient[p] *= std::sqrt(J_cell / J);
+      }
+      P.volume[p] = J_cell * P.reference_volume[p];
+    }
+  }
+}
+
 // ---------------------------------------------------------------- constitutive update
 
 template <Geometry G, class Material>

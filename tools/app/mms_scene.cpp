@@ -204,7 +204,9 @@ class MmsCase final : public SceneCase, private RunObserver {
     return "L1_<line>: eq. 3.1 of 000_1dbcb8acb6dddab9.txt, the mean over the line's material points of "
            "|q_sim - q_exact| for the line's quantity (its 'quantity' attribute; rad or m); particle_L1, "
            "particle_L2, particle_Linf: norms of the displacement error |x_p - x_exact(X_p, t)| over all "
-           "particles, weighted by reference volume (m); error_*: the scene's own relative errors against its exact "
+           "particles, weighted by reference volume (m); particle_pressure_L2: the reference-volume-weighted RMS error "
+           "of the in-plane mean stress -(sigma_xx + sigma_yy)/2 (Pa); error_*: the scene's own relative errors "
+           "against its exact "
            "solution (reports/results-format.md)";
   }
 
@@ -442,7 +444,8 @@ class MmsCase final : public SceneCase, private RunObserver {
     errors_ = ErrorTable{};
     for (const ProbeLine& line : setup_.lines) errors_.add_column("L1_" + line.name);
     if (setup_.exact_motion)
-      for (const char* name : {"particle_L1", "particle_L2", "particle_Linf"}) errors_.add_column(name);
+      for (const char* name : {"particle_L1", "particle_L2", "particle_Linf", "particle_pressure_L2"})
+        errors_.add_column(name);
     for (const std::string& name : setup_.extra_error_names) errors_.add_column(name);
     history_time_.clear();
     history_values_.assign(setup_.history_names.size(), {});
@@ -553,6 +556,18 @@ class MmsCase final : public SceneCase, private RunObserver {
       errors_.columns[column++].second.push_back(l1 / weight);
       errors_.columns[column++].second.push_back(std::sqrt(l2 / weight));
       errors_.columns[column++].second.push_back(linf);
+      // The in-plane mean stress -(sigma_xx + sigma_yy) / 2 against the exact
+      // one: its volume-weighted RMS error shows the pressure oscillation of
+      // a nearly incompressible solid (volumetric locking).
+      const std::size_t n = P.size();
+      double pressure = 0.0;
+#pragma omp parallel for schedule(static) reduction(+ : pressure)
+      for (std::size_t p = 0; p < n; ++p) {
+        const Mat2 exact = setup_.solution->fields(P.reference_position[p], t).cauchy_stress;
+        const double e = 0.5 * ((P.stress[p] - exact).trace());
+        pressure += P.reference_volume[p] * e * e;
+      }
+      errors_.columns[column++].second.push_back(std::sqrt(pressure / weight));
     }
     if (!setup_.extra_error_names.empty()) {
       const std::vector<double> extra = setup_.extra_errors(t, RunRecord{point_time_, point_simulated_, s});

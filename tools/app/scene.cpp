@@ -41,6 +41,10 @@ std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_
        "central-difference (velocities at half steps, second order) or symplectic-euler (velocities at whole "
        "steps, first order); both use eqs. 1.72 and 1.76",
        -inf, inf, false, false, {"central-difference", "symplectic-euler"}},
+      {"dilatation", KeyKind::text, std::string("particle"),
+       "particle: each particle keeps its own det F; cell-averaged: each takes its cell's mean dilatation after every "
+       "deformation update (eqs. 1.82-1.84 of the Vaango manual), the remedy for volumetric locking",
+       -inf, inf, false, false, {"particle", "cell-averaged"}},
       {"cells", KeyKind::integer, default_cells, "cells across the domain along each axis", 4, 20000},
       {"particles_per_direction", KeyKind::integer, std::int64_t(2),
        "particles per cell along each axis (2 means 4 per cell in 2D)", 1, 16},
@@ -66,6 +70,7 @@ SolverOptions solver_options(const Config& c) {
   o.method = m == "linear" ? Method::linear : m == "gimp" ? Method::gimp : Method::cpdi;
   const std::string& s = c.text("scheme");
   o.scheme = s == "usf" ? Scheme::usf : s == "musl" ? Scheme::musl : Scheme::usl;
+  o.cell_averaged_dilatation = c.text("dilatation") == "cell-averaged";
   return o;
 }
 
