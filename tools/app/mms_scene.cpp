@@ -43,6 +43,14 @@ KeySpec seeding_key() {
           -inf, inf, false, false, choices};
 }
 
+std::vector<KeySpec> problem_keys(std::vector<KeySpec> k, const std::vector<KeySpec>& own,
+                                  const std::vector<KeySpec>& material) {
+  k.insert(k.end(), own.begin(), own.end());
+  k.push_back(seeding_key());
+  k.insert(k.end(), material.begin(), material.end());
+  return k;
+}
+
 std::vector<KeySpec> material_keys(const std::string& default_material, double lambda, double mu, double density) {
   const double inf = std::numeric_limits<double>::infinity();
   return {

@@ -127,6 +127,10 @@ std::unique_ptr<SceneCase> build_mms_case(const Config& config, const MmsProblem
 // volumes, CGAL) by default when built with CGAL, else "centre".
 KeySpec seeding_key();
 
+// A problem's keys: the solver's, its own, the seeding key and the material's.
+std::vector<KeySpec> problem_keys(std::vector<KeySpec> solver, const std::vector<KeySpec>& own,
+                                  const std::vector<KeySpec>& material);
+
 // Material keys every manufactured problem accepts, with its defaults.
 std::vector<KeySpec> material_keys(const std::string& default_material, double lambda, double mu, double density);
 MaterialModel material_from(const Config& config);

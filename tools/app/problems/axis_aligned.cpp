@@ -24,12 +24,8 @@ std::vector<KeySpec> keys() {
       {"length", KeyKind::real, 1.0, "L, the side of the square or the length of the strip [m]", 0.0, inf, true},
       {"probe_points", KeyKind::integer, std::int64_t(51), "material points on each probe line", 2, 100000},
   };
-  k.insert(k.end(), own.begin(), own.end());
   // mu = 3846.15 Pa and K = 8333.33 Pa (lambda = K - 2 mu / 3), rho_0 = 1: E = 1e4 Pa, c = 100 m/s.
-  k.push_back(seeding_key());
-  const std::vector<KeySpec> material = material_keys("neo-hookean", 5769.23, 3846.15, 1.0);
-  k.insert(k.end(), material.begin(), material.end());
-  return k;
+  return problem_keys(std::move(k), own, material_keys("neo-hookean", 5769.23, 3846.15, 1.0));
 }
 
 // Young's modulus of the chosen material at small strain.

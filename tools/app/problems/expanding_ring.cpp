@@ -28,12 +28,8 @@ std::vector<KeySpec> keys() {
       {"circle_points", KeyKind::integer, std::int64_t(128),
        "material points on the circle R = r_b for the angular spectrum", 8, 65536},
   };
-  k.insert(k.end(), own.begin(), own.end());
   // E = 1e7 Pa, nu = 0: lambda = 0, mu = E / 2; rho_0 = 1000.
-  k.push_back(seeding_key());
-  const std::vector<KeySpec> material = material_keys("neo-hookean", 0.0, 5e6, 1000.0);
-  k.insert(k.end(), material.begin(), material.end());
-  return k;
+  return problem_keys(std::move(k), own, material_keys("neo-hookean", 0.0, 5e6, 1000.0));
 }
 
 ProblemSetup setup(const Config& c) {

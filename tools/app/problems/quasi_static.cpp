@@ -28,9 +28,7 @@ std::vector<KeySpec> static_scene_keys(std::vector<KeySpec> k, const std::vector
        "grid damping (eq. 1.65, zeta = ratio x 2 omega_1; 1 damps the lowest mode critically, 0: none)", 0.0, 100.0},
   };
   k.insert(k.end(), load.begin(), load.end());
-  k.push_back(seeding_key());
-  k.insert(k.end(), material.begin(), material.end());
-  return k;
+  return problem_keys(std::move(k), {}, material);
 }
 
 void add_bar_probes(ProblemSetup& s, double L, double half, int points) {

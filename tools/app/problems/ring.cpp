@@ -35,11 +35,7 @@ std::vector<KeySpec> keys() {
        "automatic differentiation of the motion and material",
        -inf, inf, false, false, {"closed-form", "derived"}},
   };
-  k.insert(k.end(), ring.begin(), ring.end());
-  k.push_back(seeding_key());
-  const std::vector<KeySpec> material = material_keys("neo-hookean", 577.0, 385.0, 1000.0);
-  k.insert(k.end(), material.begin(), material.end());
-  return k;
+  return problem_keys(std::move(k), ring, material_keys("neo-hookean", 577.0, 385.0, 1000.0));
 }
 
 ProblemSetup setup(const Config& c) {

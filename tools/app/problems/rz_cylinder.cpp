@@ -25,11 +25,7 @@ std::vector<KeySpec> keys() {
       {"period", KeyKind::real, 1.0, "T, the period of g [s]", 0.0, inf, true},
       {"probe_points", KeyKind::integer, std::int64_t(51), "material points on each probe line", 2, 100000},
   };
-  k.insert(k.end(), own.begin(), own.end());
-  k.push_back(seeding_key());
-  const std::vector<KeySpec> material = material_keys("neo-hookean", 577.0, 385.0, 1000.0);
-  k.insert(k.end(), material.begin(), material.end());
-  return k;
+  return problem_keys(std::move(k), own, material_keys("neo-hookean", 577.0, 385.0, 1000.0));
 }
 
 ProblemSetup setup(const Config& c) {

@@ -28,12 +28,8 @@ std::vector<KeySpec> keys() {
        "V of v0 = V sin(pi X / 2L) [m/s]; the strain amplitude is V / c", 0.0, inf, true},
       {"probe_points", KeyKind::integer, std::int64_t(51), "material points on the probe line", 2, 100000},
   };
-  k.insert(k.end(), own.begin(), own.end());
-  k.push_back(seeding_key());
   // Steel, E = 207 GPa, nu = 0.3.
-  const std::vector<KeySpec> material = material_keys("linear-elastic", 119.42e9, 79.615e9, 7850.0);
-  k.insert(k.end(), material.begin(), material.end());
-  return k;
+  return problem_keys(std::move(k), own, material_keys("linear-elastic", 119.42e9, 79.615e9, 7850.0));
 }
 
 ProblemSetup setup(const Config& c) {
@@ -42,12 +38,7 @@ ProblemSetup setup(const Config& c) {
   s.geometry = Geometry::plane_strain;
   s.force_free = true;
   const double L = c.real("length");
-  const double M = std::visit(
-      [](const auto& m) {
-        if constexpr (requires { m.lambda; }) return m.lambda + 2.0 * m.mu;
-        else return m.p_wave_modulus();
-      },
-      s.material);
+  const double M = p_wave_modulus(s.material);
   const analytic::VibratingBar bar{L, std::sqrt(M / c.real("density"))};
   const analytic::VibratingBarMotion motion{bar, c.real("velocity_amplitude")};
   s.solution = mms::make_solution(motion, s.material, c.real("density"), s.geometry);
