@@ -227,6 +227,13 @@ class StaticStepper final : public Stepper {
 
   // ------------------------------------------------------------ residual
 
+  // dF = I + sum_g u_g (x) G_gp over a particle's stencil.
+  static Mat2 increment(const Stencil<Shape::stencil_size>& s, const std::vector<Vec2>& u) {
+    Mat2 dF = Mat2::Identity();
+    for (int k = 0; k < Shape::stencil_size; ++k) dF += u[std::size_t(s.node[k])] * s.gradient[k].transpose();
+    return dF;
+  }
+
   // The node sums -(f_int - f_ext) at the trial displacements: trial first
   // Piola stresses in P.stress (P.volume is V^n throughout the solve).
   void node_forces(const Shape& shape, const std::vector<Vec2>& u) {
@@ -238,8 +245,7 @@ class StaticStepper final : public Stepper {
 #pragma omp for schedule(static)
       for (std::size_t p = 0; p < n; ++p) {
         shape.evaluate(p, s);
-        Mat2 dF = Mat2::Identity();
-        for (int k = 0; k < Shape::stencil_size; ++k) dF += u[std::size_t(s.node[k])] * s.gradient[k].transpose();
+        const Mat2 dF = increment(s, u);
         const Mat2 F = dF * deformation_n_[p];
         const Mat2 sigma = material_.cauchy_stress(F);
         P.stress[p] = determinant(dF) * sigma * inverse(dF).transpose();
@@ -440,13 +446,9 @@ class StaticStepper final : public Stepper {
 #pragma omp for schedule(static)
       for (std::size_t p = 0; p < n; ++p) {
         shape.evaluate(p, s);
-        Mat2 dF = Mat2::Identity();
+        const Mat2 dF = increment(s, u_);
         Vec2 move = Vec2::Zero();
-        for (int k = 0; k < Shape::stencil_size; ++k) {
-          const Vec2& u = u_[std::size_t(s.node[k])];
-          dF += u * s.gradient[k].transpose();
-          move += s.weight[k] * u;
-        }
+        for (int k = 0; k < Shape::stencil_size; ++k) move += s.weight[k] * u_[std::size_t(s.node[k])];
         P.deformation_gradient[p] = dF * deformation_n_[p];
         P.volume[p] = determinant(P.deformation_gradient[p]) * P.reference_volume[p];
         P.stress[p] = material_.cauchy_stress(P.deformation_gradient[p]);

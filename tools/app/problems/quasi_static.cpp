@@ -97,6 +97,14 @@ Lame small_strain_lame(const MaterialModel& m) {
   return {s.lambda, s.mu};
 }
 
+void check_small_displacement(const Config& c, const std::string& key, double length, const char* length_name) {
+  const double d = c.real(key);
+  if (d == 0.0) c.reject(key, "must not be zero");
+  if (std::abs(d) > 0.01 * length)
+    c.reject(key, fmt::format("must stay within 1 % of the {} ({} m): the exact solution is small-strain", length_name,
+                              0.01 * length));
+}
+
 double relative_error(double measured, double exact) {
   return exact != 0.0 ? std::abs(measured / exact - 1.0) : std::abs(measured);
 }

@@ -58,6 +58,10 @@ struct Lame {
 };
 Lame small_strain_lame(const MaterialModel& m);
 
+// Rejects a prescribed displacement that is zero or beyond 1 % of the length
+// it strains (the exact solutions it is compared with are small-strain).
+void check_small_displacement(const Config& c, const std::string& key, double length, const char* length_name);
+
 // |measured / exact - 1|, or |measured| when the exact value is zero.
 double relative_error(double measured, double exact);
 

@@ -48,11 +48,7 @@ ProblemSetup setup(const Config& c) {
   s.geometry = Geometry::plane_strain;
   s.force_free = true;
   const double H = c.real("height"), W = c.real("width_ratio") * H, shift = c.real("displacement");
-  if (shift == 0.0) c.reject("displacement", "must not be zero");
-  if (std::abs(shift) > 0.01 * H)
-    c.reject("displacement", fmt::format("must stay within 1 % of the height ({} m): the exact solution is "
-                                         "small-strain",
-                                         0.01 * H));
+  check_small_displacement(c, "displacement", H, "height");
   const Lame lame = small_strain_lame(s.material);
   const analytic::SmallStrainBar solid{lame.youngs_modulus(), lame.poisson_ratio()};
   const double density = c.real("density");

@@ -58,11 +58,7 @@ ProblemSetup setup(const Config& c) {
   s.geometry = Geometry::plane_strain;
   s.force_free = true;
   const double L = c.real("length"), half = 0.5 * c.real("height"), delta = c.real("displacement");
-  if (delta == 0.0) c.reject("displacement", "must not be zero");
-  if (std::abs(delta) > 0.01 * L)
-    c.reject("displacement", fmt::format("must stay within 1 % of the length ({} m): the exact solution is "
-                                         "small-strain",
-                                         0.01 * L));
+  check_small_displacement(c, "displacement", L, "length");
   const Lame lame = small_strain_lame(s.material);
   const analytic::SmallStrainBar bar{lame.youngs_modulus(), lame.poisson_ratio()};
   const double density = c.real("density");
