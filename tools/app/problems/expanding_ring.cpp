@@ -27,6 +27,10 @@ std::vector<KeySpec> keys() {
       {"probe_points", KeyKind::integer, std::int64_t(51), "material points on each probe line", 2, 100000},
       {"circle_points", KeyKind::integer, std::int64_t(128),
        "material points on the circle R = r_b for the angular spectrum", 8, 65536},
+      {"profile", KeyKind::text, std::string("uintah"),
+       "uintah: c1 + c2 R + c3 R^2 (rims free of traction, not of hoop stress); bubble: 16 ((R - r_i)(r_o - "
+       "R))^2 / (r_o - r_i)^4 (rims free of all stress: the control case)",
+       -inf, inf, false, false, {"uintah", "bubble"}},
   };
   // E = 1e7 Pa, nu = 0: lambda = 0, mu = E / 2; rho_0 = 1000.
   return problem_keys(std::move(k), own, material_keys("neo-hookean", 0.0, 5e6, 1000.0));
@@ -48,7 +52,8 @@ ProblemSetup setup(const Config& c) {
         else return 9.0 * m.bulk_modulus * m.shear_modulus() / (3.0 * m.bulk_modulus + m.shear_modulus());
       },
       s.material);
-  const mms::ExpandingRingMotion motion{ri, ro, c.real("amplitude"), std::sqrt(E / c.real("density"))};
+  const mms::ExpandingRingMotion motion{ri, ro, c.real("amplitude"), std::sqrt(E / c.real("density")),
+                                       c.text("profile") == "bubble"};
   s.solution = mms::make_solution(motion, s.material, c.real("density"), s.geometry);
 
   const double domain = c.real("domain");
@@ -58,7 +63,7 @@ ProblemSetup setup(const Config& c) {
   double reach = 0.0;
   for (int i = 0; i <= 100; ++i) {
     const double R = ri + (ro - ri) * i / 100.0;
-    reach = std::max(reach, R * (1.0 + motion.amplitude * std::abs(motion.c1() + motion.c2() * R + motion.c3() * R * R)));
+    reach = std::max(reach, R * (1.0 + motion.amplitude * std::abs(motion.profile(R))));
   }
   if (reach + 2.0 * s.grid.h > 0.5 * domain)
     c.reject("domain", fmt::format("the ring reaches r = {:.4g} m and needs two cells of clearance inside the "
