@@ -18,7 +18,11 @@ returns a matplotlib Figure (Agg backend; no display needed):
 * pressure_profiles: simulated values as markers, one series per refinement
   level, against an exact curve drawn as a line (the Hertz contact pressure);
 * histories: one line per case of a scalar against another recorded after
-  every step (the Hertz load against approach).
+  every step (the Hertz load against approach);
+* run_health: four panels over time from /probes/monitors, one line per case:
+  the energy balance error over its scale, J's range, the largest speed over
+  the wave speed and the largest CPDI domain distortion; a failed case's
+  failure time marked x.
 """
 import math
 import textwrap
@@ -317,6 +321,104 @@ def _line_panels(panels, title, x_label, y_label, markers):
         _label_panel(axes, x_label, y_label, panel.title)
     _suptitle(figure, title)
     return figure
+
+
+@dataclass
+class HealthCurve:
+    """One case's /probes/monitors, as the run-health figure draws them (values at `time`)."""
+    label: str
+    time: np.ndarray
+    energy_error: np.ndarray      # abs(energy_created) / scale (results.relative_energy_created)
+    min_J: np.ndarray
+    max_J: np.ndarray
+    speed_ratio: np.ndarray       # max_speed_over_wave_speed
+    distortion: np.ndarray        # max_domain_distortion; NaN for linear MPM
+    style: Style = field(default_factory=Style)
+    stopped_at: float = float("nan")   # failure time of a failed case (marked x); NaN for a completed one
+
+
+LINE_STYLES = ["-", "--", "-.", ":"]
+
+
+def run_health(curves, title):
+    """Four panels sharing the time axis, one line per curve (colour and marker from
+    its style; the line style changes after every len(COLOURS) curves so that no two
+    look alike): the energy balance error (log), min J and max J with J = 0 dotted,
+    the largest speed over wave speed, the largest domain distortion (log; a note
+    instead when every value is NaN, as for linear MPM). A curve with a finite
+    `stopped_at` gets an x there, at the height of its last drawn value."""
+    figure, axes = plt.subplots(4, 1, figsize=(10.5, 11.0), sharex=True, squeeze=False, constrained_layout=True)
+    energy, jacobian, speed, distortion = axes[:, 0]
+    drawn = {energy: False, distortion: False}
+    for k, curve in enumerate(curves):
+        line = dict(color=curve.style.colour, marker=curve.style.marker, markersize=4, linewidth=1.2,
+                    linestyle=LINE_STYLES[(k // len(COLOURS)) % len(LINE_STYLES)])
+        t = np.asarray(curve.time, float)
+        # log panels: a value that is not positive (no error at all, or NaN) is left out of the line
+        for panel, values in ((energy, curve.energy_error), (distortion, curve.distortion)):
+            positive = _positive(values)
+            if np.isfinite(positive).any():
+                panel.plot(t, positive, **line)
+                _mark_stop(panel, curve, t, positive)
+                drawn[panel] = True
+        for values in (curve.min_J, curve.max_J):
+            jacobian.plot(t, values, **line)
+            _mark_stop(jacobian, curve, t, values)
+        # every curve has a line here (NaN values draw nothing): the legend is taken from it
+        speed.plot(t, curve.speed_ratio, label=curve.label, **line)
+        _mark_stop(speed, curve, t, curve.speed_ratio)
+    jacobian.axhline(0.0, color="black", linestyle=":", linewidth=1.0)
+    jacobian.annotate("J = 0", (0.0, 0.0), xycoords=("axes fraction", "data"), xytext=(3, 3),
+                      textcoords="offset points", fontsize=8)
+    no_domains = all(np.isnan(np.asarray(c.distortion, float)).all() for c in curves)
+    for panel, note in ((energy, "no nonzero energy balance error"),
+                        (distortion, "no CPDI domains" if no_domains else "no finite distortion")):
+        if drawn[panel]:
+            panel.set_yscale("log")
+            _plain_log_labels(panel)
+        else:
+            panel.text(0.5, 0.5, note, transform=panel.transAxes, ha="center", va="center", color="grey")
+    _label_panel(energy, "", "|energy created| / scale", "energy balance error")
+    _label_panel(jacobian, "", "J = det F", "min J and max J over the particles")
+    _label_panel(speed, "", "max |v| / c", "largest particle speed over its wave speed")
+    _label_panel(distortion, "time t [s]", "max domain distortion", "largest domain distortion (1: square)")
+    handles, labels = speed.get_legend_handles_labels()
+    if any(math.isfinite(c.stopped_at) for c in curves):
+        handles.append(matplotlib.lines.Line2D([], [], color="black", marker="x", linestyle="none", markersize=8,
+                                               markeredgewidth=2))
+        labels.append("failure time of a failed case")
+    if handles:
+        energy.legend(handles, labels, fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)
+    _suptitle(figure, title)
+    return figure
+
+
+def _positive(values):
+    """The values with those not finite and positive set to NaN (a gap on a log axis)."""
+    values = np.asarray(values, float)
+    return np.where(np.isfinite(values) & (values > 0), values, np.nan)
+
+
+def _mark_stop(axes, curve, t, values):
+    """An x at the curve's failure time, at the height of its last finite value, joined
+    to that value by a dotted line when the run stopped after its last output."""
+    finite = np.nonzero(np.isfinite(np.asarray(values, float)))[0]
+    if not (math.isfinite(curve.stopped_at) and finite.size):
+        return
+    last_time, last_value = t[finite[-1]], values[finite[-1]]
+    axes.plot([last_time, curve.stopped_at], [last_value, last_value], ":", color=curve.style.colour,
+              linewidth=1.0)
+    axes.plot([curve.stopped_at], [last_value], "x", color=curve.style.colour, markersize=9, markeredgewidth=2)
+
+
+def _plain_log_labels(axes):
+    """Tick labels as plain numbers (1.05, not 1.05 x 10^0) on a log axis whose range is
+    within a decade, where matplotlib labels the minor ticks in scientific notation."""
+    low, high = axes.get_ylim()
+    if 0 < low and high < 10 * low:
+        plain = matplotlib.ticker.FuncFormatter(lambda value, _: f"{value:g}")
+        axes.yaxis.set_major_formatter(plain)
+        axes.yaxis.set_minor_formatter(plain)
 
 
 def _label_panel(axes, x_label, y_label, title):

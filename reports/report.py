@@ -33,8 +33,8 @@ import figures
 import gate
 import norms
 import orders
-from results import (SuiteDirectoryError, lookup_error, read_contact_pressure, read_error_spectrum,
-                     read_point_history, read_probe_lines, read_scene_history, read_suite)
+from results import (SuiteDirectoryError, lookup_error, read_contact_pressure, read_error_spectrum, read_monitors,
+                     read_point_history, read_probe_lines, read_scene_history, read_suite, relative_energy_created)
 from series import DEFAULT_REFINE_KEY, refinement_series, series_levels, usable
 
 ORDERS_CSV_COLUMNS = (
@@ -554,6 +554,87 @@ def load_approach_figure(study, all_series, directory):
                                     f"(/probes/history), one line per case, by {all_series[0].refine}.")
 
 
+HEALTH_MAX_CASES = 12          # with more cases than this the run-health figure draws a selection
+
+
+def health_selection(cases):
+    """The cases the run-health figure draws, in the order given, and whether that is
+    a selection: all of them when there are at most HEALTH_MAX_CASES; else, so that
+    the figure stays readable, those that did not complete plus the finest completed
+    case (smallest h; the last listed on a tie) of each value of the `method` key."""
+    if len(cases) <= HEALTH_MAX_CASES:
+        return list(cases), False
+    finest = {}
+    for case in cases:
+        method = str(case.keys.get("method", ""))
+        if case.completed and (method not in finest or case.h <= finest[method].h):
+            finest[method] = case
+    kept = {c.id for c in finest.values()}
+    return [c for c in cases if not c.completed or c.id in kept], True
+
+
+def health_label(series, case, monitors):
+    """The series' keys and the case's level, as the other figures label cases; a
+    case that did not complete adds its status, failure time and reason. Returns
+    (label, failure time or NaN)."""
+    # a lone series without a method key is labelled "all cases" (series.py): its level says enough
+    label = level_label(series, case) if series.label == "all cases" else f"{series.label}, {level_label(series, case)}"
+    if case.completed:
+        return label, float("nan")
+    # failure_time is NaN when the file does not say (results-format.md): then the last time reached or recorded
+    stop = next((t for t in (float(case.attribute("failure_time")), case.time_reached, float(monitors.time[-1]))
+                 if math.isfinite(t)), float("nan"))
+    reason = case.attribute("failure_reason", "")
+    when = f" at {time_text(stop)}" if math.isfinite(stop) else ""
+    return f"{label} ({case.status}{when}{': ' + reason if reason else ''})", stop
+
+
+def health_figure(study, all_series, directory):
+    """The run's health over time from /probes/monitors (results-format.md,
+    "/probes/monitors"), one line per case; None when no case of the study has the
+    group (results files written before the monitors existed)."""
+    found, without = [], 0
+    for series in all_series:
+        for case in series.cases:
+            monitors = read_monitors(case.results_path) if case.results is not None else None
+            if monitors is not None:
+                found.append((series, case, monitors))
+            elif case.results is not None:
+                without += 1
+    if not found:
+        return None
+    chosen, selected = health_selection([case for _, case, _ in found])
+    chosen_ids = {c.id for c in chosen}
+    curves = []
+    for series, case, monitors in found:
+        if case.id not in chosen_ids:
+            continue
+        label, stop = health_label(series, case, monitors)
+        # one colour and marker per drawn case, as level_styles gives each case of a series its own
+        k = len(curves)
+        style = figures.Style(figures.COLOURS[k % len(figures.COLOURS)], figures.MARKERS[k % len(figures.MARKERS)])
+        curves.append(figures.HealthCurve(label, monitors.time, relative_energy_created(monitors),
+                                          monitors.column("min_J"), monitors.column("max_J"),
+                                          monitors.column("max_speed_over_wave_speed"),
+                                          monitors.column("max_domain_distortion"), style, stop))
+    figure = figures.run_health(curves, f"{study}: run health at the output times")
+    path = directory / f"{slug(study, 'health')}.png"
+    figures.save_png(figure, path)
+    caption = (f"{study}: the run's health at each output time (/probes/monitors), one line per case. From the top: "
+               "the energy balance error, abs(energy_created) over the larger of the initial energy and the largest "
+               "abs(work) any one work_* term has done so far, the scale of the blow-up test (log scale); "
+               "min J and max J over the particles (the lower and upper line of a case's colour), dotted at J = 0; "
+               "the largest particle speed over its wave speed; the largest CPDI domain distortion (1: a square "
+               "domain; log scale; none for linear MPM). x: the failure time of a failed case, at the height of its "
+               "last recorded value (dotted from its last output).")
+    if selected:
+        caption += (f" {len(chosen)} of the {len(found)} cases with monitors are drawn: those that failed and the "
+                    f"finest completed case of each method.")
+    if without:
+        caption += f" {without} case(s) of the study have results without /probes/monitors (written before them)."
+    return FigureEntry(study, path, caption)
+
+
 def study_figures(suite, study, rows, directory):
     cases = suite.cases_of(study)
     all_series = study_series(suite, study)
@@ -568,6 +649,7 @@ def study_figures(suite, study, rows, directory):
         entries.append(work_precision_figure(study, all_series, norm, norms.norm_unit(norm, quantities), styles,
                                              directory))
     entries.append(stability_figure(study, all_series, directory))
+    entries.append(health_figure(study, all_series, directory))
     entries.append(profile_figure(study, all_series, directory))
     entries.append(history_figure(study, all_series, directory))
     entries.append(contact_pressure_figure(study, all_series, directory))

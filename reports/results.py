@@ -11,7 +11,8 @@ error, or a damaged file) is kept with ``results = None`` and a note saying why,
 so that every report and the gate can show it instead of stopping on it.
 Only root attributes, /errors and the /measurements scalars are read up front;
 probe arrays (lines, points, the circle, /probes/contact_pressure,
-/probes/history) are read on demand for the few cases that are plotted.
+/probes/history, /probes/monitors) are read on demand for the cases that are
+plotted.
 """
 import json
 import math
@@ -335,3 +336,60 @@ def read_scene_history(path):
         values = {name: np.asarray(group[name][:], float) for name in group
                   if name != "time" and isinstance(group[name], h5py.Dataset) and group[name].shape == time.shape}
         return SceneHistory(time, values)
+
+
+# The /probes/monitors datasets (results-format.md, "/probes/monitors (every
+# scene)"), one value per output time; the work_* terms are what the energy
+# balance subtracts.
+WORK_COLUMNS = ("work_body_force", "work_constraints", "work_contact", "work_damping")
+MONITOR_COLUMNS = ("kinetic_energy", "strain_energy") + WORK_COLUMNS + (
+    "energy_created", "min_J", "max_J", "max_speed_over_wave_speed", "max_domain_distortion", "particles_near_edge")
+
+
+@dataclass(frozen=True)
+class RunMonitors:
+    initial_energy: float         # attribute initial_energy [J per unit depth; per radian in r-z]
+    time: np.ndarray              # T output times
+    columns: dict                 # dataset name -> T values, for the datasets shaped like time
+
+    def column(self, name):
+        """The dataset `name`, or NaN at every output time when the file does not have it."""
+        return self.columns.get(name, np.full(self.time.shape, np.nan))
+
+
+def read_monitors(path):
+    """/probes/monitors, or None when absent (results files written before the
+    monitors existed) or without an output time."""
+    with h5py.File(path, "r") as f:
+        group = f.get("probes/monitors")
+        if not isinstance(group, h5py.Group) or "time" not in group:
+            return None
+        time = np.asarray(group["time"][:], float)
+        if time.size == 0:
+            return None
+        columns = {name: np.asarray(group[name][:], float) for name in group
+                   if name != "time" and isinstance(group[name], h5py.Dataset) and group[name].shape == time.shape}
+        return RunMonitors(float(group.attrs.get("initial_energy", float("nan"))), time, columns)
+
+
+def energy_balance_scale(initial_energy, works):
+    """What the energy balance error is divided by at each output time: the larger
+    of the initial energy and the largest abs(work) any one work_* term has done
+    up to that time - the scale of the solver's blow-up test (results-format.md,
+    energy_created), so that a run stopped as `energy blow-up` plots above
+    energy_blowup_factor. The current kinetic and strain energy are left out on
+    purpose: a blow-up inflates them and would hide itself. The running maximum
+    is over output times (the solver keeps it over every step). NaN values are
+    passed over; NaN where nothing is finite or the scale is not positive.
+    works: one array per work_* term, each shaped like the output times."""
+    works = [np.asarray(w, float) for w in works]
+    parts = [np.full(works[0].shape, float(initial_energy))]
+    parts += [np.fmax.accumulate(np.abs(w)) for w in works]
+    scale = np.fmax.reduce(np.stack(parts), axis=0)     # fmax: a NaN loses to any number
+    return np.where(scale > 0, scale, np.nan)
+
+
+def relative_energy_created(monitors):
+    """abs(energy_created) over energy_balance_scale at each output time of a RunMonitors."""
+    scale = energy_balance_scale(monitors.initial_energy, [monitors.column(w) for w in WORK_COLUMNS])
+    return np.abs(monitors.column("energy_created")) / scale

@@ -1,0 +1,173 @@
+"""Requirements of the run-health figure (reports/report.py, health_figure): drawn
+per study from /probes/monitors (reports/results-format.md, "/probes/monitors"),
+one line per case, a failed case's failure time marked; left out for a study
+whose results files have no monitors (written before they existed), such as
+the stored gold directory; the energy balance error is divided by the scale
+results.energy_balance_scale defines."""
+import json
+import shutil
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+import figures
+import report
+from conftest import write_case_results
+from results import Case, CaseResults, RunMonitors, energy_balance_scale, relative_energy_created
+
+GOLD = Path(__file__).parent / "gold"
+INITIAL_ENERGY = 100.0
+# the column each gold study's expectations name (gold/suite.toml), so that /errors has it
+GOLD_NORMS = {"ring": "L1_theta0", "ring-stopped": "L1_theta0", "axis-aligned": "L1_line_y_mid",
+              "rz-cylinder": "L1_line_z_quarter"}
+GOLD_FAILURE = {"ring-stopped": ("nan", 0.121)}    # its manifest detail: "nan at t = 0.121 s"
+
+
+def synthetic_monitors(times, method, cells, failed=False):
+    """Plausible /probes/monitors columns at `times`: a body force doing 20 t J of work,
+    damping taking t J, energy made from nothing -1e-3 t (32 / cells) E0 (twice that for
+    GIMP, 5 E0 t for a failed run), kinetic and strain splitting what is left 60:40 so that the balance
+    closes; J within 1 -+ 0.1 t; distortion 1 + 0.5 t for CPDI, 1 for GIMP, NaN for
+    linear MPM."""
+    t = np.asarray(times, float)
+    work = {"work_body_force": 20.0 * t, "work_constraints": 0.0 * t, "work_contact": 0.0 * t,
+            "work_damping": -1.0 * t}
+    created = (5.0 if failed else -1e-3 * 32 / cells * (2.0 if method == "gimp" else 1.0)) * INITIAL_ENERGY * t
+    energy = INITIAL_ENERGY + sum(work.values()) + created
+    distortion = {"cpdi": 1.0 + 0.5 * t, "gimp": 1.0 + 0.0 * t}.get(method, np.full(t.shape, np.nan))
+    return {"time": t, "kinetic_energy": 0.6 * energy, "strain_energy": 0.4 * energy, **work,
+            "energy_created": created, "min_J": 1.0 - 0.1 * t, "max_J": 1.0 + 0.1 * t,
+            "max_speed_over_wave_speed": 0.05 + 0.01 * t, "max_domain_distortion": distortion,
+            "particles_near_edge": 0.0 * t}
+
+
+def gold_with_results(directory, monitors_in=()):
+    """A copy of reports/gold (manifest.json, suite.toml, cases/*.json) with a results
+    file (conftest.write_case_results) for every case that ran: the gold directory
+    keeps no .h5 files (.gitignore). Cases of the studies in `monitors_in` get a
+    /probes/monitors group at the output times they reached."""
+    shutil.copytree(GOLD, directory)
+    manifest = json.loads((directory / "manifest.json").read_text())
+    for entry in manifest["cases"]:
+        if entry["status"] not in ("completed", "failed"):
+            continue                                  # the crashed case keeps no results file, as in the suite
+        keys, study = entry["keys"], entry["study"]
+        reason, failure_time = GOLD_FAILURE.get(study, ("", float("nan")))
+        times = [t for t in keys["output_times"] if not t > failure_time]
+        h = float(keys.get("domain", keys.get("length", keys.get("outer_radius", 1.0)))) / keys["cells"]
+        errors = {GOLD_NORMS[study]: [h * h * t for t in times], "particle_L2": [h * h * t for t in times]}
+        path = directory / entry["results"]
+        write_case_results(path, keys, h, errors, times, status=entry["status"], failure_reason=reason,
+                           failure_time=failure_time)
+        if study in monitors_in:
+            with h5py.File(path, "a") as f:
+                group = f["probes"].create_group("monitors")
+                group.attrs["initial_energy"] = INITIAL_ENERGY
+                for name, values in synthetic_monitors(times, keys["method"], keys["cells"],
+                                                       entry["status"] == "failed").items():
+                    group[name] = values
+    return directory
+
+
+@pytest.fixture
+def drawn(monkeypatch):
+    """The curves handed to figures.run_health, by figure title."""
+    calls = {}
+    original = figures.run_health
+
+    def record(curves, title, *args, **kwargs):
+        calls[title] = curves
+        return original(curves, title, *args, **kwargs)
+    monkeypatch.setattr(figures, "run_health", record)
+    return calls
+
+
+needs_gold = pytest.mark.skipif(not (GOLD / "manifest.json").is_file(), reason="reports/gold is not there")
+
+
+@needs_gold
+def test_health_figure_per_study_with_monitors(tmp_path, drawn):
+    """Requirement: each study whose results files have /probes/monitors gets a
+    run-health figure, embedded in report.html and linked from report.md, one line
+    per case labelled like the other figures; a failed case is labelled with its
+    status and failure time and marked there; a study without monitors gets none."""
+    directory = gold_with_results(tmp_path / "suite", monitors_in=("ring", "ring-stopped", "rz-cylinder"))
+    written, figure_count = report.write_report(directory, tmp_path / "out")
+    names = sorted(p.name for p in (tmp_path / "out" / "figures").glob("*-health.png"))
+    assert names == ["ring-health.png", "ring-stopped-health.png", "rz-cylinder-health.png"]   # not axis-aligned
+    markdown = written["markdown"].read_text()
+    assert all(f"](figures/{name})" in markdown for name in names)
+    assert "ring: the run's health at each output time (/probes/monitors)" in markdown
+    page = written["html"].read_text()
+    assert page.count("src='data:image/png;base64,") == figure_count
+    assert "<figcaption>ring-stopped: the run&#x27;s health at each output time" in page
+
+    ring = drawn["ring: run health at the output times"]
+    assert [c.label for c in ring] == ["method=gimp, cells=32", "method=gimp, cells=64", "method=cpdi, cells=32",
+                                       "method=cpdi, cells=64"]
+    assert all(np.isnan(c.stopped_at) for c in ring)
+    # the energy balance error of the finest cpdi case: 1e-3 t (32/64) E0 over the scale, the larger
+    # of E0 and the body force's work so far (20 t, growing)
+    finest = ring[-1]
+    scale = np.maximum(INITIAL_ENERGY, 20.0 * finest.time)
+    assert np.allclose(finest.energy_error, 0.5e-3 * INITIAL_ENERGY * finest.time / scale)
+    assert np.allclose(finest.distortion, 1.0 + 0.5 * finest.time)
+
+    (stopped,) = drawn["ring-stopped: run health at the output times"]
+    assert stopped.label == "method=linear, cells=32 (failed at t = 0.121 s: nan)"
+    assert stopped.stopped_at == pytest.approx(0.121)
+    assert list(stopped.time) == [0.1] and np.isnan(stopped.distortion).all()    # linear MPM: no CPDI domains
+
+
+@needs_gold
+def test_gold_without_monitors_has_no_health_figure(tmp_path, drawn):
+    """Requirement: results files without /probes/monitors (written before the
+    monitors existed) give no run-health figure, no error and no empty figure:
+    the stored gold directory as it is, and with results files but no monitors."""
+    for name, directory in (("gold", GOLD), ("results", gold_with_results(tmp_path / "suite"))):
+        written, figure_count = report.write_report(directory, tmp_path / name)
+        assert figure_count > 0
+        assert not list((tmp_path / name / "figures").glob("*health*"))
+        assert "health" not in written["markdown"].read_text()
+    assert drawn == {}
+
+
+def test_energy_balance_scale_on_hand_made_arrays():
+    """Requirement: the scale is, at each output time, the larger of the initial
+    energy and the largest abs(work) any one work_* term has done up to then (the
+    solver's blow-up scale; the current kinetic + strain energy play no part);
+    NaN values are passed over; NaN when nothing is positive."""
+    kinetic = np.array([5.0, 20.0, 1.0, np.nan])
+    strain = np.array([5.0, 5.0, 1.0, np.nan])
+    works = [np.array([0.0, -12.0, 3.0, 4.0]),       # running max of abs: 0, 12, 12, 12
+             np.array([0.0, 1.0, 30.0, np.nan]),     # 0, 1, 30, 30
+             np.zeros(4),
+             np.array([0.0, -2.0, -3.0, -4.0])]      # 0, 2, 3, 4
+    # t0: the initial energy; t1: the body force's 12 (kinetic + strain, 25, do not count);
+    # t2, t3: the constraints' largest work so far
+    assert np.array_equal(energy_balance_scale(10.0, works), [10.0, 12.0, 30.0, 30.0])
+    assert np.isnan(energy_balance_scale(0.0, [np.zeros(2)])).all()
+
+    columns = dict(zip(("kinetic_energy", "strain_energy", "work_body_force", "work_constraints", "work_contact",
+                        "work_damping"), [kinetic, strain, *works]))
+    columns["energy_created"] = np.array([-1.0, 1.2, 3.0, np.nan])
+    monitors = RunMonitors(10.0, np.array([0.0, 1.0, 2.0, 3.0]), columns)
+    ratio = relative_energy_created(monitors)
+    assert np.allclose(ratio[:3], 0.1) and np.isnan(ratio[3])
+
+
+def test_many_cases_draw_the_failed_and_the_finest_completed_of_each_method():
+    """Requirement: with more than report.HEALTH_MAX_CASES cases the figure draws only
+    the cases that failed and the finest completed case of each method."""
+    def case(method, cells, status="completed"):
+        results = CaseResults({"h": 1.0 / cells, "status": status}, np.zeros(0), {}, {})
+        return Case(f"{method}-{cells}", "s", {"method": method, "cells": cells}, status, "", Path("x.h5"),
+                    results=results)
+    cases = [case(m, n, "failed" if (m, n) == ("linear", 256) else "completed")
+             for m in ("linear", "cpdi") for n in (8, 16, 32, 64, 128, 256, 512)]
+    chosen, selected = report.health_selection(cases)
+    assert selected and [c.id for c in chosen] == ["linear-256", "linear-512", "cpdi-512"]
+    few, selected = report.health_selection(cases[:report.HEALTH_MAX_CASES])
+    assert not selected and len(few) == report.HEALTH_MAX_CASES
