@@ -328,22 +328,28 @@ def read_scene_history(path):
     """/probes/history: its time and every scalar recorded with it, or None when absent or empty."""
     with h5py.File(path, "r") as f:
         group = f.get("probes/history")
-        if not isinstance(group, h5py.Group) or "time" not in group or "quantity" in group.attrs:
+        if isinstance(group, h5py.Group) and "quantity" in group.attrs:
             return None
-        time = np.asarray(group["time"][:], float)
-        if time.size == 0:
-            return None
-        values = {name: np.asarray(group[name][:], float) for name in group
-                  if name != "time" and isinstance(group[name], h5py.Dataset) and group[name].shape == time.shape}
-        return SceneHistory(time, values)
+        read = _time_columns(group)
+        return None if read is None else SceneHistory(*read)
 
 
-# The /probes/monitors datasets (results-format.md, "/probes/monitors (every
-# scene)"), one value per output time; the work_* terms are what the energy
-# balance subtracts.
+def _time_columns(group):
+    """A probe group's `time` and every other dataset shaped like it, or None when
+    the group is absent, has no `time` or no time in it."""
+    if not isinstance(group, h5py.Group) or "time" not in group:
+        return None
+    time = np.asarray(group["time"][:], float)
+    if time.size == 0:
+        return None
+    columns = {name: np.asarray(group[name][:], float) for name in group
+               if name != "time" and isinstance(group[name], h5py.Dataset) and group[name].shape == time.shape}
+    return time, columns
+
+
+# The work_* datasets of /probes/monitors (results-format.md, "/probes/monitors
+# (every scene)"), one value per output time: what the energy balance subtracts.
 WORK_COLUMNS = ("work_body_force", "work_constraints", "work_contact", "work_damping")
-MONITOR_COLUMNS = ("kinetic_energy", "strain_energy") + WORK_COLUMNS + (
-    "energy_created", "min_J", "max_J", "max_speed_over_wave_speed", "max_domain_distortion", "particles_near_edge")
 
 
 @dataclass(frozen=True)
@@ -362,14 +368,8 @@ def read_monitors(path):
     monitors existed) or without an output time."""
     with h5py.File(path, "r") as f:
         group = f.get("probes/monitors")
-        if not isinstance(group, h5py.Group) or "time" not in group:
-            return None
-        time = np.asarray(group["time"][:], float)
-        if time.size == 0:
-            return None
-        columns = {name: np.asarray(group[name][:], float) for name in group
-                   if name != "time" and isinstance(group[name], h5py.Dataset) and group[name].shape == time.shape}
-        return RunMonitors(float(group.attrs.get("initial_energy", float("nan"))), time, columns)
+        read = _time_columns(group)
+        return None if read is None else RunMonitors(float(group.attrs.get("initial_energy", float("nan"))), *read)
 
 
 def energy_balance_scale(initial_energy, works):
