@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "shape/cpdi.hpp"
+#include "shape/cpdi_exact.hpp"
 #include "shape/gimp.hpp"
 #include "shape/linear.hpp"
 #include "monitors.hpp"
@@ -18,6 +19,7 @@ const char* to_string(Method m) {
     case Method::linear: return "linear";
     case Method::gimp: return "gimp";
     case Method::cpdi: return "cpdi";
+    case Method::cpdi_exact: return "cpdi-exact";
   }
   return "?";
 }
@@ -324,11 +326,32 @@ std::unique_ptr<Stepper> make_for_geometry(Model model, const SolverOptions& o, 
     case Method::linear: return make_for_shape<LinearShapeT<G>>(std::move(model), o, material, std::move(stages));
     case Method::gimp: return make_for_shape<GimpShapeT<G>>(std::move(model), o, material, std::move(stages));
     case Method::cpdi: return make_for_shape<CpdiShapeT<G>>(std::move(model), o, material, std::move(stages));
+    case Method::cpdi_exact:
+      if constexpr (G == Geometry::plane_strain)
+        return make_for_shape<CpdiExactShapeT<G>>(std::move(model), o, material, std::move(stages));
+      throw std::invalid_argument("method cpdi-exact is plane strain only");
   }
   throw std::logic_error("unknown method");
 }
 
 }  // namespace
+
+void check_domain_outlines(const Particles& P, Method method) {
+  if (P.domain_first.empty() && P.domain_vertex.empty()) return;
+  if (method != Method::cpdi_exact)
+    throw std::invalid_argument(fmt::format("particle outlines serve method cpdi-exact only, not {}", to_string(method)));
+  if (P.domain_first.size() != P.size() + 1 || P.domain_first.front() != 0 ||
+      P.domain_first.back() != P.domain_vertex.size())
+    throw std::invalid_argument("particle outlines need one start per particle and an end");
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    const std::uint32_t count = P.domain_first[p + 1] - P.domain_first[p];
+    if (P.domain_first[p + 1] < P.domain_first[p] || (count != 0 && count < 3) ||
+        count > std::uint32_t(CpdiExactShape::kMaxOutline))
+      throw std::invalid_argument(fmt::format("particle {} has an outline of {} points; an outline has 3 to {}", p,
+                                              int(P.domain_first[p + 1]) - int(P.domain_first[p]),
+                                              CpdiExactShape::kMaxOutline));
+  }
+}
 
 std::unique_ptr<Stepper> make_stepper(Model model, const SolverOptions& options,
                                       const MaterialModel& material,
@@ -361,6 +384,7 @@ std::unique_ptr<Stepper> make_stepper(Model model, const SolverOptions& options,
   if (options.method != Method::linear && model.particles.half_size.size() != n)
     throw std::invalid_argument(fmt::format("method {} needs a particle domain (half_size) for every particle",
                                             to_string(options.method)));
+  check_domain_outlines(model.particles, options.method);
   if (options.geometry == Geometry::axisymmetric) {
     if (model.particles.hoop_stretch.size() != n || model.particles.hoop_stress.size() != n)
       throw std::invalid_argument("an axisymmetric run needs the hoop stretch and hoop stress of every particle");

@@ -63,6 +63,11 @@ class Stepper {
   EnergyLedger ledger_;
 };
 
+// Particle outlines (Particles::domain_vertex), when there are any, belong to
+// exact CPDI and hold 3 to CpdiExactShape::kMaxOutline points each; throws
+// std::invalid_argument otherwise.
+void check_domain_outlines(const Particles& P, Method method);
+
 // Checks the particles carry what the method needs, then picks the stepper
 // instantiation for (method, material): the one dispatch.
 std::unique_ptr<Stepper> make_stepper(Model model, const SolverOptions& options,

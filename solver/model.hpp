@@ -17,7 +17,7 @@
 
 namespace mpmvv {
 
-enum class Method { linear, gimp, cpdi };
+enum class Method { linear, gimp, cpdi, cpdi_exact };
 enum class Scheme { usl, usf, musl };
 
 const char* to_string(Method m);

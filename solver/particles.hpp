@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "tensor.hpp"
@@ -27,6 +28,15 @@ struct Particles {
   // x and y. GIMP uses it as is (uGIMP: the size is not convected); CPDI spans
   // its parallelogram with r_i = F_p (l_i e_i), eq. 1.97. Empty for linear MPM.
   std::vector<Vec2> half_size;
+
+  // Optional, exact CPDI only: a particle domain of any polygonal shape, the
+  // reference outline's points relative to X_p (domain_vertex[domain_first[p]]
+  // up to domain_first[p + 1]); its current outline is x_p + F_p (X_k - X_p).
+  // A particle with no points keeps the parallelogram of half_size. Seeding
+  // gives the pieces a curved boundary cuts their own outline, so that the
+  // domains tile the body exactly. Empty (both) when no particle has one.
+  std::vector<std::uint32_t> domain_first;
+  std::vector<Vec2> domain_vertex;
 
   // Axisymmetric runs only: the hoop stretch F_theta (r / R for the exact
   // motion) and the hoop stress sigma_theta.

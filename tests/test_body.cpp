@@ -148,4 +148,36 @@ TEST(Body, BoxesTouchingTheCircleClipCorrectly) {
   }
 }
 
+// Outlines of clipped parts (exact CPDI domains): a box the ring's inner
+// circle cuts, a box holding the whole hole (one piece with a hole, on a
+// bridge) and a box the ring crosses twice (two pieces, on a bridge). The
+// outline's own Green's-theorem area equals the exact clipped area less the
+// circular segments its chords leave out, each below L^3 / (12 R).
+TEST(Body, OutlinesOfClippedPartsHoldTheirArea) {
+  const Body ring = Body::annulus(Vec2::Zero(), 0.4, 0.6);
+  const double chord = 0.01;
+  struct Box {
+    Vec2 lower, upper;
+  };
+  for (const Box& box : {Box{Vec2(0.38, -0.03), Vec2(0.43, 0.02)}, Box{Vec2(-0.7, -0.7), Vec2(0.7, 0.7)},
+                         Box{Vec2(-0.7, -0.05), Vec2(0.7, 0.05)}, Box{Vec2(0.45, 0.1), Vec2(0.5, 0.15)}}) {
+    const std::vector<Vec2> outline = ring.clip_outline(box.lower, box.upper, chord);
+    ASSERT_GE(outline.size(), 3u);
+    double twice_area = 0.0;
+    for (std::size_t k = 0; k < outline.size(); ++k) {
+      const Vec2& a = outline[k];
+      const Vec2& b = outline[(k + 1) % outline.size()];
+      twice_area += a.x() * b.y() - b.x() * a.y();
+      EXPECT_GE(a.x(), box.lower.x() - 1e-12);
+      EXPECT_LE(a.x(), box.upper.x() + 1e-12);
+    }
+    const double exact = ring.clip(box.lower, box.upper).area;
+    const double perimeter = 2.0 * pi * (0.4 + 0.6);
+    const double sagitta_bound = perimeter / chord * chord * chord * chord / (12.0 * 0.4);
+    EXPECT_NEAR(0.5 * twice_area, exact, sagitta_bound) << "box from (" << box.lower.x() << ", " << box.lower.y() << ")";
+    EXPECT_GT(0.5 * twice_area, 0.0);
+  }
+  EXPECT_THROW(ring.clip_outline(Vec2(0.38, -0.03), Vec2(0.43, 0.02), 0.0), std::invalid_argument);
+}
+
 #endif  // MPMVV_HAVE_CGAL

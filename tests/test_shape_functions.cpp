@@ -15,11 +15,13 @@
 
 #include "solver/particles.hpp"
 #include "solver/shape/cpdi.hpp"
+#include "solver/shape/cpdi_exact.hpp"
 #include "solver/shape/gimp.hpp"
 #include "solver/shape/linear.hpp"
 
 namespace {
 
+using mpmvv::CpdiExactShape;
 using mpmvv::CpdiShape;
 using mpmvv::GimpShape;
 using mpmvv::GridGeometry;
@@ -72,6 +74,8 @@ template <>
 double wall_margin_in_cells<GimpShape>() { return 0.25; }  // the half-size h/4: the domain may touch a wall
 template <>
 double wall_margin_in_cells<CpdiShape>() { return 0.25; }
+template <>
+double wall_margin_in_cells<CpdiExactShape>() { return 0.25; }
 
 // Positions on and a hair either side of every place where a weight changes
 // formula, around node (3, 4) and the cell beyond it, plus the last accepted
@@ -163,7 +167,7 @@ void expect_shape_properties(const GridGeometry& grid, const Particles& P) {
 template <class Shape>
 class ShapeFunctionTest : public ::testing::Test {};
 
-using ShapeFamilies = ::testing::Types<LinearShape, GimpShape, CpdiShape>;
+using ShapeFamilies = ::testing::Types<LinearShape, GimpShape, CpdiShape, CpdiExactShape>;
 TYPED_TEST_SUITE(ShapeFunctionTest, ShapeFamilies);
 
 // (a)-(d) at random interior positions.
@@ -240,6 +244,18 @@ TEST(CpdiShape, PropertiesHoldForDeformedDomains) {
     for (double ox : {0.0, 0.25, 0.5, 1e-12, -1e-12})
       x.push_back(grid.origin + grid.h * Vec2(4.0 + ox, 4.0 - ox));
     expect_shape_properties<CpdiShape>(grid, particles_at(grid, x, std::vector<Mat2>(x.size(), F)));
+  }
+}
+
+// The same for the exactly integrated domains; their weights are integrals
+// of non-negative hats, so non-negative too.
+TEST(CpdiExactShape, PropertiesHoldForDeformedDomains) {
+  const GridGeometry grid = small_grid();
+  for (const Mat2& F : {simple_shear(1.5), rotated_stretch()}) {
+    std::vector<Vec2> x = random_interior_positions(grid, 100, 11);
+    for (double ox : {0.0, 0.25, 0.5, 1e-12, -1e-12})
+      x.push_back(grid.origin + grid.h * Vec2(4.0 + ox, 4.0 - ox));
+    expect_shape_properties<CpdiExactShape>(grid, particles_at(grid, x, std::vector<Mat2>(x.size(), F)));
   }
 }
 

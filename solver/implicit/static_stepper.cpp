@@ -13,6 +13,7 @@
 
 #include "newton_krylov.hpp"
 #include "solver/shape/cpdi.hpp"
+#include "solver/shape/cpdi_exact.hpp"
 #include "solver/shape/gimp.hpp"
 #include "solver/shape/linear.hpp"
 #include "solver/monitors.hpp"
@@ -503,10 +504,12 @@ std::unique_ptr<Stepper> make_static_stepper(Model model, const SolverOptions& o
   if (options.method != Method::linear && model.particles.half_size.size() != model.particles.size())
     throw std::invalid_argument(fmt::format("method {} needs a particle domain (half_size) for every particle",
                                             to_string(options.method)));
+  check_domain_outlines(model.particles, options.method);
   switch (options.method) {
     case Method::linear: return make_for_shape<LinearShape>(std::move(model), material, std::move(stages), o);
     case Method::gimp: return make_for_shape<GimpShapeT<Geometry::plane_strain>>(std::move(model), material, std::move(stages), o);
     case Method::cpdi: return make_for_shape<CpdiShape>(std::move(model), material, std::move(stages), o);
+    case Method::cpdi_exact: return make_for_shape<CpdiExactShape>(std::move(model), material, std::move(stages), o);
   }
   throw std::logic_error("unknown method");
 }

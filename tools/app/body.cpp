@@ -282,6 +282,62 @@ AreaMoments Body::clip(const Vec2& lower, const Vec2& upper) const {
   return integrate(set, lower);
 }
 
+namespace {
+
+// The boundary curves as points, each arc as chords of at most `max_chord`
+// (the sweep taken about the arc's centre, signed by its orientation).
+template <class Curves>
+void append_outline(const Curves& curves, double max_chord, std::vector<Vec2>& out) {
+  for (auto it = curves.curves_begin(); it != curves.curves_end(); ++it) {
+    const Arc& arc = *it;
+    const Vec2 p0(value(arc.source(), 0), value(arc.source(), 1));
+    const Vec2 p1(value(arc.target(), 0), value(arc.target(), 1));
+    out.push_back(p0);
+    if (arc.is_linear()) continue;
+    const Circle circle = arc.supporting_circle();
+    const Vec2 c(CGAL::to_double(circle.center().x()), CGAL::to_double(circle.center().y()));
+    const double r = std::sqrt(CGAL::to_double(circle.squared_radius()));
+    const Vec2 a = p0 - c, b = p1 - c;
+    // |sweep| <= pi (the arcs are x-monotone); its sign is the arc's
+    // orientation, not the cross product's, which is ambiguous at pi.
+    const double sweep = (arc.orientation() == CGAL::COUNTERCLOCKWISE ? 1.0 : -1.0) *
+                         std::atan2(std::abs(a.x() * b.y() - a.y() * b.x()), a.dot(b));
+    const int chords = std::max(1, int(std::ceil(std::abs(sweep) * r / max_chord)));
+    const double start = std::atan2(a.y(), a.x());
+    for (int k = 1; k < chords; ++k) {
+      const double angle = start + sweep * k / chords;
+      out.push_back(c + r * Vec2(std::cos(angle), std::sin(angle)));
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<Vec2> Body::clip_outline(const Vec2& lower, const Vec2& upper, double max_chord) const {
+  if (!(max_chord > 0.0)) throw std::invalid_argument("an outline needs a positive chord length");
+  PolygonSet set = impl_->set;
+  set.intersection(straight_polygon({lower, Vec2(upper.x(), lower.y()), upper, Vec2(lower.x(), upper.y())}));
+  std::list<PolygonWithHoles> pieces;
+  set.polygons_with_holes(std::back_inserter(pieces));
+  std::vector<Vec2> outline;
+  auto add_ring = [&](const auto& ring) {
+    std::vector<Vec2> points;
+    append_outline(ring, max_chord, points);
+    if (points.empty()) return;
+    // A later ring hangs off the chain's first point: back to it (which
+    // closes the ring before), over to the new ring, round it and closed; the
+    // chain's own closing edge is the bridge back.
+    if (!outline.empty()) outline.push_back(outline.front());
+    outline.insert(outline.end(), points.begin(), points.end());
+    if (outline.size() > points.size()) outline.push_back(points.front());
+  };
+  for (const PolygonWithHoles& p : pieces) {
+    add_ring(p.outer_boundary());
+    for (auto h = p.holes_begin(); h != p.holes_end(); ++h) add_ring(*h);
+  }
+  return outline;
+}
+
 AreaMoments Body::whole() const { return integrate(impl_->set, Vec2::Zero()); }
 
 }  // namespace mpmvv::app

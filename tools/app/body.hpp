@@ -40,6 +40,11 @@ class Body {
   // The part of the body inside the box.
   AreaMoments clip(const Vec2& lower, const Vec2& upper) const;
   AreaMoments whole() const;
+  // The outline of the part of the body inside the box: one closed chain of
+  // points, its arcs cut into chords no longer than `max_chord`; several
+  // pieces (or a piece with a hole) are joined by bridges walked both ways,
+  // which add nothing to any integral over the region by Green's theorem.
+  std::vector<Vec2> clip_outline(const Vec2& lower, const Vec2& upper, double max_chord) const;
 
  private:
   struct Impl;

@@ -335,7 +335,30 @@ class MmsCase final : public SceneCase, private RunObserver {
     Vec2 centroid;
     double area;      // int dA
     double moment_r;  // int x dA (r in r-z)
+    std::vector<Vec2> outline;  // exact CPDI only: the clipped piece's outline (empty: the whole sub-cell)
   };
+
+  // Exact CPDI domains follow a clipped piece's outline, arcs in chords of a
+  // quarter of the particle spacing (the chord's sagitta, spacing^2 / (128 R),
+  // is far below what a piece's area can tell).
+  bool outlines() const { return options_.method == Method::cpdi_exact && exact_seeding_; }
+
+  // The outline of a piece and a sliver joined to it: a whole sub-cell's
+  // square where either has none, then the sliver's ring on a bridge from the
+  // first point (walked there and back, it adds nothing to any integral).
+  static std::vector<Vec2> joined_outline(const Piece& piece, const Piece& sliver, double spacing) {
+    auto ring = [&](const Piece& q) {
+      if (!q.outline.empty()) return q.outline;
+      const Vec2 l = 0.5 * spacing * Vec2(1.0, 1.0), lo = q.centroid - l, hi = q.centroid + l;
+      return std::vector<Vec2>{lo, Vec2(hi.x(), lo.y()), hi, Vec2(lo.x(), hi.y())};
+    };
+    std::vector<Vec2> out = ring(piece);
+    const std::vector<Vec2> other = ring(sliver);
+    out.push_back(out.front());
+    out.insert(out.end(), other.begin(), other.end());
+    out.push_back(other.front());
+    return out;
+  }
 
   std::vector<Piece> pieces_of_cell(int i, int j, int ppd) const {
     const GridGeometry& grid = setup_.grid;
@@ -345,13 +368,17 @@ class MmsCase final : public SceneCase, private RunObserver {
       for (int a = 0; a < ppd; ++a) {
         const Vec2 lower = grid.node_position(i, j) + spacing * Vec2(a, b);
         const Vec2 centre = lower + 0.5 * spacing * Vec2(1.0, 1.0);
-        const Piece whole{centre, spacing * spacing, spacing * spacing * centre.x()};
+        const Piece whole{centre, spacing * spacing, spacing * spacing * centre.x(), {}};
 #ifdef MPMVV_HAVE_CGAL
         if (exact_seeding_) {
           const Body& body = *setup_.body;
           if (body.boundary_may_meet(lower, lower + spacing * Vec2(1.0, 1.0))) {
             const AreaMoments m = body.clip(lower, lower + spacing * Vec2(1.0, 1.0));
-            if (m.area > 1e-14 * spacing * spacing) pieces.push_back({m.centroid(), m.area, m.moment_x});
+            if (m.area > 1e-14 * spacing * spacing) {
+              pieces.push_back({m.centroid(), m.area, m.moment_x, {}});
+              if (outlines()) pieces.back().outline = body.clip_outline(lower, lower + spacing * Vec2(1.0, 1.0),
+                                                                         0.25 * spacing);
+            }
           } else if (body.contains(centre)) {
             pieces.push_back(whole);
           }
@@ -373,6 +400,7 @@ class MmsCase final : public SceneCase, private RunObserver {
           merged.centroid = (merged.centroid * merged.area + it->centroid * it->area) / (merged.area + it->area);
           merged.area += it->area;
           merged.moment_r += it->moment_r;
+          if (outlines()) merged.outline = joined_outline(merged, *it, spacing);
         } else {
           kept.push_back(*it);
         }
@@ -421,6 +449,14 @@ class MmsCase final : public SceneCase, private RunObserver {
       P.half_size.resize(pieces.size());
       for (std::size_t p = 0; p < pieces.size(); ++p)
         P.half_size[p] = 0.5 * std::sqrt(pieces[p].area) * Vec2(1.0, 1.0);
+    }
+    if (outlines()) {
+      P.domain_first.assign(pieces.size() + 1, 0);
+      P.domain_vertex.clear();
+      for (std::size_t p = 0; p < pieces.size(); ++p) {
+        for (const Vec2& v : pieces[p].outline) P.domain_vertex.push_back(v - pieces[p].centroid);
+        P.domain_first[p + 1] = std::uint32_t(P.domain_vertex.size());
+      }
     }
     (void)spacing;
   }

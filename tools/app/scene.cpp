@@ -33,8 +33,9 @@ std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_
                                  std::vector<double> default_output_times) {
   const double inf = std::numeric_limits<double>::infinity();
   return {
-      {"method", KeyKind::text, std::string("cpdi"), "shape functions: linear (standard MPM), gimp (uGIMP), cpdi",
-       -inf, inf, false, false, {"linear", "gimp", "cpdi"}},
+      {"method", KeyKind::text, std::string("cpdi"), "shape functions: linear (standard MPM), gimp (uGIMP), cpdi, cpdi-exact (CPDI domains "
+       "integrated exactly over the cells they cross; plane strain)",
+       -inf, inf, false, false, {"linear", "gimp", "cpdi", "cpdi-exact"}},
       {"scheme", KeyKind::text, std::string("usl"), "stress update: usl (update stress last), usf (first), musl (modified USL)",
        -inf, inf, false, false, {"usl", "usf", "musl"}},
       {"time_integration", KeyKind::text, std::string("central-difference"),
@@ -67,7 +68,10 @@ std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_
 SolverOptions solver_options(const Config& c) {
   SolverOptions o;
   const std::string& m = c.text("method");
-  o.method = m == "linear" ? Method::linear : m == "gimp" ? Method::gimp : Method::cpdi;
+  o.method = m == "linear"   ? Method::linear
+             : m == "gimp"   ? Method::gimp
+             : m == "cpdi"   ? Method::cpdi
+                             : Method::cpdi_exact;
   const std::string& s = c.text("scheme");
   o.scheme = s == "usf" ? Scheme::usf : s == "musl" ? Scheme::musl : Scheme::usl;
   o.cell_averaged_dilatation = c.text("dilatation") == "cell-averaged";

@@ -21,7 +21,7 @@ int main(int argc, char** argv) {
   double end_time = 0.1;
   int repeats = 3;
   std::vector<int> threads{1, 2};
-  std::vector<std::string> methods{"linear", "gimp", "cpdi"};
+  std::vector<std::string> methods{"linear", "gimp", "cpdi", "cpdi-exact"};
   std::string scheme = "usl";
   app.add_option("--cells", cells, "cells across the 3 m domain")->check(CLI::Range(8, 4096));
   app.add_option("--end-time", end_time, "simulated interval per repeat [s]")->check(CLI::PositiveNumber);

@@ -1,0 +1,223 @@
+// CPDI domains integrated exactly. The domain of particle p is the
+// parallelogram of cpdi.hpp, spanned by r_1 = F_p (l_x e_x), r_2 = F_p (l_y e_y)
+// about x_p (002_c3305cb8b1bc1490.txt eq. 1.97), but the averages of eq. 1.94,
+//   S_gp = (1 / V_p) int_{Omega_p} S_g dA,   G_gp = (1 / V_p) int_{Omega_p} grad S_g dA,
+// are taken over the domain itself rather than over the bilinear interpolation
+// of the grid basis from its four corners (eq. 1.95). The corner interpolation
+// is exact inside one cell but not across a cell line, where S_g has a kink;
+// inside the body the domains share their edges and these errors cancel from
+// one domain to the next, but along the body's boundary they do not, and where
+// the boundary carries stress (a tangential stress on a curved rim) the nodal
+// force keeps an error of relative size (l / h)^2 that does not fall with h.
+//
+// The integration: the domain is clipped to every cell it meets (Sutherland-
+// Hodgman against the cell's four sides, in grid coordinates), and on each
+// piece the moments int 1, int u, int v, int u v (u, v the coordinates in the
+// cell, 0 to 1) follow from the piece's vertices by Green's theorem. Clipping
+// a polygon that is not convex (a piece of a rim, two pieces joined by a
+// bridge) against a half-plane may join its pieces along the clipping line;
+// such edges lie on the line and enclose nothing, so the moments stay exact. The
+// bilinear basis of the cell's nodes, (1-u)(1-v), u(1-v), (1-u)v, uv, and its
+// gradient are combinations of these moments. The domain may meet up to 3 x 3
+// cells (a 4 x 4 block of nodes); a larger domain is reported by `inside`.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstddef>
+
+#include "../particles.hpp"
+#include "stencil.hpp"
+
+namespace mpmvv {
+
+// int 1, int u, int v, int u v over a polygon, counter-clockwise vertices
+// (u_k, v_k): with c_k = u_k v_{k+1} - u_{k+1} v_k,
+//   A = (1/2) sum c_k,  int u = (1/6) sum (u_k + u_{k+1}) c_k  (v alike),
+//   int u v = (1/24) sum c_k (u_k v_{k+1} + 2 u_k v_k + 2 u_{k+1} v_{k+1} + u_{k+1} v_k).
+struct PolygonMoments {
+  double area = 0.0, u = 0.0, v = 0.0, uv = 0.0;
+};
+
+inline PolygonMoments polygon_moments(const Vec2* vertex, int count) {
+  PolygonMoments m;
+  for (int k = 0; k < count; ++k) {
+    const Vec2& a = vertex[k];
+    const Vec2& b = vertex[k + 1 == count ? 0 : k + 1];
+    const double c = a.x() * b.y() - b.x() * a.y();
+    m.area += c;
+    m.u += (a.x() + b.x()) * c;
+    m.v += (a.y() + b.y()) * c;
+    m.uv += c * (a.x() * b.y() + 2.0 * a.x() * a.y() + 2.0 * b.x() * b.y() + b.x() * a.y());
+  }
+  m.area /= 2.0;
+  m.u /= 6.0;
+  m.v /= 6.0;
+  m.uv /= 24.0;
+  return m;
+}
+
+// The part of a polygon on the side axis-coordinate >= bound (keep_above)
+// or <= bound: each edge gives at most two points, and no more than
+// `capacity` are written (the callers' buffers hold every realistic outline).
+inline int clip_polygon(const Vec2* in, int count, int axis, double bound, bool keep_above, Vec2* out,
+                        int capacity) {
+  int n = 0;
+  for (int k = 0; k < count && n + 2 <= capacity; ++k) {
+    const Vec2& a = in[k];
+    const Vec2& b = in[k + 1 == count ? 0 : k + 1];
+    const double da = keep_above ? a[axis] - bound : bound - a[axis];
+    const double db = keep_above ? b[axis] - bound : bound - b[axis];
+    if (da >= 0.0) out[n++] = a;
+    if ((da >= 0.0) != (db >= 0.0)) out[n++] = a + (da / (da - db)) * (b - a);
+  }
+  return n;
+}
+
+template <Geometry G>
+struct CpdiExactShapeT {
+  static_assert(G == Geometry::plane_strain, "exact CPDI integration is plane strain only");
+  static constexpr int block = 4;                       // nodes per direction the domain may reach
+  static constexpr int stencil_size = block * block;
+  static constexpr int kMaxOutline = 32;  // points of a particle's own outline
+  static constexpr int kClipBuffer = 8 * kMaxOutline;
+  static constexpr const char* name = "cpdi-exact";
+  static constexpr Geometry geometry = G;
+  static constexpr bool reads_deformation_gradient = true;
+
+  const GridGeometry* grid;
+  const Vec2* position;
+  const Mat2* deformation_gradient;
+  const Vec2* half_size;
+  const std::uint32_t* domain_first;  // null when no particle has an outline of its own
+  const Vec2* domain_vertex;
+  double gradient_scale;  // 1, but for a deliberate fault (SolverOptions::cpdi_gradient_scale)
+
+  static CpdiExactShapeT bind(const GridGeometry& grid, const Particles& particles,
+                              const Mat2* deformation_gradient = nullptr, double gradient_scale = 1.0) {
+    const bool outlines = !particles.domain_first.empty();
+    return {&grid,
+            particles.position.data(),
+            deformation_gradient ? deformation_gradient : particles.deformation_gradient.data(),
+            particles.half_size.data(),
+            outlines ? particles.domain_first.data() : nullptr,
+            outlines ? particles.domain_vertex.data() : nullptr,
+            gradient_scale};
+  }
+
+  // s_p = [r_1 r_2], the current domain half-vectors as columns (eq. 1.97).
+  Mat2 domain(std::size_t p) const {
+    Mat2 s = deformation_gradient[p];
+    s.col(0) *= half_size[p].x();
+    s.col(1) *= half_size[p].y();
+    return s;
+  }
+
+  // The domain's current outline in grid coordinates, counter-clockwise when
+  // det F > 0: the particle's own outline (Particles::domain_vertex) mapped by
+  // F_p, or the parallelogram's four corners. Returns the number of points.
+  int outline(std::size_t p, Vec2* c) const {
+    const Vec2 x = grid_coordinate(*grid, position[p]);
+    if (domain_first != nullptr && domain_first[p + 1] > domain_first[p]) {
+      const Mat2 F = deformation_gradient[p] / grid->h;
+      const int count = int(domain_first[p + 1] - domain_first[p]);
+      const Vec2* d = domain_vertex + domain_first[p];
+      for (int k = 0; k < count; ++k) c[k] = x + F * d[k];
+      return count;
+    }
+    const Mat2 s = domain(p) / grid->h;
+    c[0] = x - s.col(0) - s.col(1);
+    c[1] = x + s.col(0) - s.col(1);
+    c[2] = x + s.col(0) + s.col(1);
+    c[3] = x - s.col(0) + s.col(1);
+    return 4;
+  }
+
+  // The outline's bounding box in grid coordinates.
+  static void bounds(const Vec2* c, int count, Vec2& lo, Vec2& hi) {
+    lo = hi = c[0];
+    for (int k = 1; k < count; ++k) {
+      lo = lo.cwiseMin(c[k]);
+      hi = hi.cwiseMax(c[k]);
+    }
+  }
+
+  // The lowest cell of the block the outline starts in.
+  static void block_origin(const Vec2& lo, const GridGeometry& grid, int& i0, int& j0) {
+    i0 = std::clamp(int(std::floor(lo.x())), 0, grid.cells_x - 1);
+    j0 = std::clamp(int(std::floor(lo.y())), 0, grid.cells_y - 1);
+  }
+
+  void evaluate(std::size_t p, Stencil<stencil_size>& st) const {
+    const GridGeometry& g = *grid;
+    Vec2 c[kMaxOutline];
+    const int count = outline(p, c);
+    Vec2 lo, hi;
+    bounds(c, count, lo, hi);
+    int i0, j0;
+    block_origin(lo, g, i0, j0);
+    double mass[stencil_size] = {};
+    Vec2 grad[stencil_size];
+    for (Vec2& v : grad) v.setZero();
+    // Each cell of the block: clip, take the moments about the cell's corner.
+    Vec2 a[kClipBuffer], b[kClipBuffer], piece[kClipBuffer];
+    double area = 0.0;
+    for (int cj = 0; cj < block - 1 && j0 + cj < g.cells_y; ++cj) {
+      if (j0 + cj >= hi.y()) break;
+      int n = clip_polygon(c, count, 1, j0 + cj, true, a, kClipBuffer);
+      n = clip_polygon(a, n, 1, j0 + cj + 1, false, b, kClipBuffer);
+      if (n < 3) continue;
+      for (int ci = 0; ci < block - 1 && i0 + ci < g.cells_x; ++ci) {
+        if (i0 + ci >= hi.x()) break;
+        int m = clip_polygon(b, n, 0, i0 + ci, true, a, kClipBuffer);
+        m = clip_polygon(a, m, 0, i0 + ci + 1, false, piece, kClipBuffer);
+        if (m < 3) continue;
+        for (int k = 0; k < m; ++k) piece[k] -= Vec2(i0 + ci, j0 + cj);
+        const PolygonMoments q = polygon_moments(piece, m);
+        area += q.area;
+        // Nodes (0,0), (1,0), (0,1), (1,1) of the cell in the block.
+        const int k00 = cj * block + ci, k10 = k00 + 1, k01 = k00 + block, k11 = k01 + 1;
+        // Integrals of non-negative functions; a sliver's may round to -1e-17.
+        mass[k00] += std::max(0.0, q.area - q.u - q.v + q.uv);
+        mass[k10] += std::max(0.0, q.u - q.uv);
+        mass[k01] += std::max(0.0, q.v - q.uv);
+        mass[k11] += std::max(0.0, q.uv);
+        grad[k00] += Vec2(-(q.area - q.v), -(q.area - q.u));
+        grad[k10] += Vec2(q.area - q.v, -q.u);
+        grad[k01] += Vec2(-q.v, q.area - q.u);
+        grad[k11] += Vec2(q.v, q.u);
+      }
+    }
+    // Divide by the domain's area (in cells^2) and turn d/du into d/dx.
+    const double inv_area = 1.0 / area, gradient_factor = gradient_scale * inv_area / g.h;
+    const int nx = g.nodes_x(), last_i = g.cells_x, last_j = g.cells_y;
+    for (int kj = 0; kj < block; ++kj)
+      for (int ki = 0; ki < block; ++ki) {
+        const int k = kj * block + ki;
+        // Nodes beyond the grid carry nothing; name an existing node for them.
+        const int i = std::min(i0 + ki, last_i), j = std::min(j0 + kj, last_j);
+        st.node[k] = j * nx + i;
+        st.weight[k] = mass[k] * inv_area;
+        st.gradient[k] = gradient_factor * grad[k];
+      }
+  }
+
+  // The centre between the walls, the whole outline in the grid, and within
+  // the 3 x 3 cells the stencil holds.
+  bool inside(std::size_t p) const {
+    if (!inside_walls(*grid, position[p])) return false;
+    Vec2 c[kMaxOutline];
+    const int count = outline(p, c);
+    Vec2 lo, hi;
+    bounds(c, count, lo, hi);
+    if (!inside_cells(*grid, lo) || !inside_cells(*grid, hi)) return false;
+    int i0, j0;
+    block_origin(lo, *grid, i0, j0);
+    return hi.x() <= i0 + block - 1 && hi.y() <= j0 + block - 1;
+  }
+};
+
+using CpdiExactShape = CpdiExactShapeT<Geometry::plane_strain>;
+
+}  // namespace mpmvv
