@@ -327,9 +327,7 @@ std::unique_ptr<Stepper> make_for_geometry(Model model, const SolverOptions& o, 
     case Method::gimp: return make_for_shape<GimpShapeT<G>>(std::move(model), o, material, std::move(stages));
     case Method::cpdi: return make_for_shape<CpdiShapeT<G>>(std::move(model), o, material, std::move(stages));
     case Method::cpdi_exact:
-      if constexpr (G == Geometry::plane_strain)
-        return make_for_shape<CpdiExactShapeT<G>>(std::move(model), o, material, std::move(stages));
-      throw std::invalid_argument("method cpdi-exact is plane strain only");
+      return make_for_shape<CpdiExactShapeT<G>>(std::move(model), o, material, std::move(stages));
   }
   throw std::logic_error("unknown method");
 }

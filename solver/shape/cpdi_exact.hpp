@@ -18,7 +18,10 @@
 // bridge) against a half-plane may join its pieces along the clipping line;
 // such edges lie on the line and enclose nothing, so the moments stay exact. The
 // bilinear basis of the cell's nodes, (1-u)(1-v), u(1-v), (1-u)v, uv, and its
-// gradient are combinations of these moments. The domain may meet up to 3 x 3
+// gradient are combinations of these moments. In r-z the averages carry the
+// weight r (as in cpdi.hpp): S_gp = int r S_g / int r, G_gp = int r grad S_g /
+// int r and <S/r>_p = int S_g / int r, with r linear in u, so the moments
+// int u^2 and int u^2 v join. The domain may meet up to 3 x 3
 // cells (a 4 x 4 block of nodes); a larger domain is reported by `inside`.
 #pragma once
 
@@ -36,10 +39,16 @@ namespace mpmvv {
 // (u_k, v_k): with c_k = u_k v_{k+1} - u_{k+1} v_k,
 //   A = (1/2) sum c_k,  int u = (1/6) sum (u_k + u_{k+1}) c_k  (v alike),
 //   int u v = (1/24) sum c_k (u_k v_{k+1} + 2 u_k v_k + 2 u_{k+1} v_{k+1} + u_{k+1} v_k).
+// With `radial` also the moments an r weight needs (r linear in u):
+//   int u^2 = (1/12) sum c_k (u_k^2 + u_k u_{k+1} + u_{k+1}^2),
+//   int u^2 v = (1/60) sum c_k (u_k^2 (3 v_k + v_{k+1}) + 2 u_k u_{k+1} (v_k + v_{k+1})
+//                               + u_{k+1}^2 (v_k + 3 v_{k+1})).
 struct PolygonMoments {
   double area = 0.0, u = 0.0, v = 0.0, uv = 0.0;
+  double uu = 0.0, uuv = 0.0;  // radial moments only
 };
 
+template <bool radial = false>
 inline PolygonMoments polygon_moments(const Vec2* vertex, int count) {
   PolygonMoments m;
   for (int k = 0; k < count; ++k) {
@@ -50,11 +59,18 @@ inline PolygonMoments polygon_moments(const Vec2* vertex, int count) {
     m.u += (a.x() + b.x()) * c;
     m.v += (a.y() + b.y()) * c;
     m.uv += c * (a.x() * b.y() + 2.0 * a.x() * a.y() + 2.0 * b.x() * b.y() + b.x() * a.y());
+    if constexpr (radial) {
+      m.uu += c * (a.x() * a.x() + a.x() * b.x() + b.x() * b.x());
+      m.uuv += c * (a.x() * a.x() * (3.0 * a.y() + b.y()) + 2.0 * a.x() * b.x() * (a.y() + b.y()) +
+                    b.x() * b.x() * (a.y() + 3.0 * b.y()));
+    }
   }
   m.area /= 2.0;
   m.u /= 6.0;
   m.v /= 6.0;
   m.uv /= 24.0;
+  m.uu /= 12.0;
+  m.uuv /= 60.0;
   return m;
 }
 
@@ -77,7 +93,6 @@ inline int clip_polygon(const Vec2* in, int count, int axis, double bound, bool 
 
 template <Geometry G>
 struct CpdiExactShapeT {
-  static_assert(G == Geometry::plane_strain, "exact CPDI integration is plane strain only");
   static constexpr int block = 4;                       // nodes per direction the domain may reach
   static constexpr int stencil_size = block * block;
   static constexpr int kMaxOutline = 32;  // points of a particle's own outline
@@ -151,18 +166,30 @@ struct CpdiExactShapeT {
 
   void evaluate(std::size_t p, Stencil<stencil_size>& st) const {
     const GridGeometry& g = *grid;
-    Vec2 c[kMaxOutline];
-    const int count = outline(p, c);
+    constexpr bool radial = G == Geometry::axisymmetric;
+    const double axis = -g.origin.x() / g.h;  // grid coordinate of r = 0
+    Vec2 c[kClipBuffer];
+    int count = outline(p, c);
     Vec2 lo, hi;
     bounds(c, count, lo, hi);
+    if constexpr (radial) {
+      // In r-z a domain that reaches over the axis keeps its part at r >= 0:
+      // the mirrored ghost nodes stand for the rest, and r must not turn negative.
+      if (lo.x() < axis) {
+        Vec2 kept[kClipBuffer];
+        count = clip_polygon(c, count, 0, axis, true, kept, kClipBuffer);
+        for (int k = 0; k < count; ++k) c[k] = kept[k];
+        lo.x() = axis;
+      }
+    }
     int i0, j0;
     block_origin(lo, g, i0, j0);
-    double mass[stencil_size] = {};
+    double mass[stencil_size] = {}, radial_mass[stencil_size] = {};
     Vec2 grad[stencil_size];
     for (Vec2& v : grad) v.setZero();
     // Each cell of the block: clip, take the moments about the cell's corner.
     Vec2 a[kClipBuffer], b[kClipBuffer], piece[kClipBuffer];
-    double area = 0.0;
+    double area = 0.0;  // int dA, or in r-z int r dA (cells^3)
     for (int cj = 0; cj < block - 1 && j0 + cj < g.cells_y; ++cj) {
       if (j0 + cj >= hi.y()) break;
       int n = clip_polygon(c, count, 1, j0 + cj, true, a, kClipBuffer);
@@ -174,8 +201,7 @@ struct CpdiExactShapeT {
         m = clip_polygon(a, m, 0, i0 + ci + 1, false, piece, kClipBuffer);
         if (m < 3) continue;
         for (int k = 0; k < m; ++k) piece[k] -= Vec2(i0 + ci, j0 + cj);
-        const PolygonMoments q = polygon_moments(piece, m);
-        area += q.area;
+        const PolygonMoments q = polygon_moments<radial>(piece, m);
         // Nodes (0,0), (1,0), (0,1), (1,1) of the cell in the block.
         const int k00 = cj * block + ci, k10 = k00 + 1, k01 = k00 + block, k11 = k01 + 1;
         // Integrals of non-negative functions; a sliver's may round to -1e-17.
@@ -183,13 +209,29 @@ struct CpdiExactShapeT {
         mass[k10] += std::max(0.0, q.u - q.uv);
         mass[k01] += std::max(0.0, q.v - q.uv);
         mass[k11] += std::max(0.0, q.uv);
-        grad[k00] += Vec2(-(q.area - q.v), -(q.area - q.u));
-        grad[k10] += Vec2(q.area - q.v, -q.u);
-        grad[k01] += Vec2(-q.v, q.area - q.u);
-        grad[k11] += Vec2(q.v, q.u);
+        if constexpr (radial) {
+          // r = h (rho + u) with rho the cell's left edge: int r f = h (rho int f + int u f).
+          const double rho = i0 + ci - axis;
+          area += rho * q.area + q.u;
+          radial_mass[k00] += std::max(0.0, rho * (q.area - q.u - q.v + q.uv) + (q.u - q.uu - q.uv + q.uuv));
+          radial_mass[k10] += std::max(0.0, rho * (q.u - q.uv) + (q.uu - q.uuv));
+          radial_mass[k01] += std::max(0.0, rho * (q.v - q.uv) + (q.uv - q.uuv));
+          radial_mass[k11] += std::max(0.0, rho * q.uv + q.uuv);
+          grad[k00] += rho * Vec2(-(q.area - q.v), -(q.area - q.u)) + Vec2(-(q.u - q.uv), -(q.u - q.uu));
+          grad[k10] += rho * Vec2(q.area - q.v, -q.u) + Vec2(q.u - q.uv, -q.uu);
+          grad[k01] += rho * Vec2(-q.v, q.area - q.u) + Vec2(-q.uv, q.u - q.uu);
+          grad[k11] += rho * Vec2(q.v, q.u) + Vec2(q.uv, q.uu);
+        } else {
+          area += q.area;
+          grad[k00] += Vec2(-(q.area - q.v), -(q.area - q.u));
+          grad[k10] += Vec2(q.area - q.v, -q.u);
+          grad[k01] += Vec2(-q.v, q.area - q.u);
+          grad[k11] += Vec2(q.v, q.u);
+        }
       }
     }
-    // Divide by the domain's area (in cells^2) and turn d/du into d/dx.
+    // Divide by the domain's area (in cells^2; in r-z its int r dA, in cells^3)
+    // and turn d/du into d/dx. In r-z <S/r> = int S dA / int r dA.
     const double inv_area = 1.0 / area, gradient_factor = gradient_scale * inv_area / g.h;
     const int nx = g.nodes_x(), last_i = g.cells_x, last_j = g.cells_y;
     for (int kj = 0; kj < block; ++kj)
@@ -198,13 +240,18 @@ struct CpdiExactShapeT {
         // Nodes beyond the grid carry nothing; name an existing node for them.
         const int i = std::min(i0 + ki, last_i), j = std::min(j0 + kj, last_j);
         st.node[k] = j * nx + i;
-        st.weight[k] = mass[k] * inv_area;
         st.gradient[k] = gradient_factor * grad[k];
+        if constexpr (radial) {
+          st.weight[k] = radial_mass[k] * inv_area;
+          st.hoop[k] = mass[k] * inv_area / g.h;
+        } else {
+          st.weight[k] = mass[k] * inv_area;
+        }
       }
   }
 
-  // The centre between the walls, the whole outline in the grid, and within
-  // the 3 x 3 cells the stencil holds.
+  // The centre between the walls (in r-z off the axis), the whole outline in
+  // the grid, and within the 3 x 3 cells the stencil holds.
   bool inside(std::size_t p) const {
     if (!inside_walls(*grid, position[p])) return false;
     Vec2 c[kMaxOutline];
@@ -212,6 +259,8 @@ struct CpdiExactShapeT {
     Vec2 lo, hi;
     bounds(c, count, lo, hi);
     if (!inside_cells(*grid, lo) || !inside_cells(*grid, hi)) return false;
+    if constexpr (G == Geometry::axisymmetric)
+      if (!(position[p].x() > 0.0)) return false;
     int i0, j0;
     block_origin(lo, *grid, i0, j0);
     return hi.x() <= i0 + block - 1 && hi.y() <= j0 + block - 1;

@@ -34,7 +34,7 @@ std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_
   const double inf = std::numeric_limits<double>::infinity();
   return {
       {"method", KeyKind::text, std::string("cpdi"), "shape functions: linear (standard MPM), gimp (uGIMP), cpdi, cpdi-exact (CPDI domains "
-       "integrated exactly over the cells they cross; plane strain)",
+       "integrated exactly over the cells they cross)",
        -inf, inf, false, false, {"linear", "gimp", "cpdi", "cpdi-exact"}},
       {"scheme", KeyKind::text, std::string("usl"), "stress update: usl (update stress last), usf (first), musl (modified USL)",
        -inf, inf, false, false, {"usl", "usf", "musl"}},
