@@ -105,6 +105,10 @@ class ExplicitStepper final : public Stepper {
     if (!shape.inside(p)) {
       if (!inside_walls(model_.grid, x))
         return {"outside grid", fmt::format("the particle at ({:.6g}, {:.6g}) has crossed a wall", x.x(), x.y())};
+      if constexpr (requires { shape.within_stencil(p); })
+        if (!shape.within_stencil(p))
+          return {"domain too wide", fmt::format("the domain of the particle at ({:.6g}, {:.6g}) spans more cells "
+                                                 "than its stencil holds", x.x(), x.y())};
       return {"outside grid", fmt::format("support of the particle at ({:.6g}, {:.6g}) leaves the grid", x.x(), x.y())};
     }
     return {"", ""};

@@ -17,7 +17,7 @@ namespace mpmvv {
 
 // Why a particle stops the run.
 struct ParticleFault {
-  std::string reason;  // "nan", "non-positive J", "outside grid"
+  std::string reason;  // "nan", "non-positive J", "outside grid", "domain too wide" (exact CPDI)
   std::string detail;  // values that show it
 };
 

@@ -365,6 +365,21 @@ TEST(TimeLoop, BadInitialParticleIsReportedAsData) {
     }
 }
 
+// Exact CPDI's stencil holds 3 x 3 cells: a particle stretched beyond them
+// stops the run with its own reason, not as "outside grid".
+TEST(TimeLoop, ExactCpdiDomainBeyondItsStencilIsReportedAsTooWide) {
+  Model model = disk_model(Method::cpdi_exact);
+  const std::size_t bad = model.particles.size() / 3;
+  model.particles.deformation_gradient[bad] = Vec2(14.0, 1.0 / 14.0).asDiagonal();  // 7 cells long
+  auto stepper = mpmvv::make_stepper(std::move(model), SolverOptions{Method::cpdi_exact, Scheme::usl},
+                                     MaterialModel{kSolid}, nullptr);
+  NullObserver observer;
+  const mpmvv::RunOutcome o = mpmvv::run_time_loop(*stepper, short_run(0.1), observer);
+  EXPECT_FALSE(o.completed);
+  EXPECT_EQ(o.failure_reason, "domain too wide");
+  EXPECT_EQ(o.failure_particle, static_cast<long long>(bad));
+}
+
 // A body force that turns NaN for one lone particle from t = 0.2 s on.
 class PoisonAfter final : public mpmvv::BodyForce {
  public:

@@ -95,7 +95,10 @@ template <Geometry G>
 struct CpdiExactShapeT {
   static constexpr int block = 4;                       // nodes per direction the domain may reach
   static constexpr int stencil_size = block * block;
-  static constexpr int kMaxOutline = 32;  // points of a particle's own outline
+  // Points of a particle's own outline: a cut piece has its sub-cell's
+  // corners and the chords of an arc (about 10); one that took in slivers has
+  // theirs too, two more per bridge (37 seen on the ring at 128 cells).
+  static constexpr int kMaxOutline = 64;
   static constexpr int kClipBuffer = 8 * kMaxOutline;
   static constexpr const char* name = "cpdi-exact";
   static constexpr Geometry geometry = G;
@@ -254,13 +257,26 @@ struct CpdiExactShapeT {
   // the grid, and within the 3 x 3 cells the stencil holds.
   bool inside(std::size_t p) const {
     if (!inside_walls(*grid, position[p])) return false;
+    if constexpr (G == Geometry::axisymmetric)
+      if (!(position[p].x() > 0.0)) return false;
     Vec2 c[kMaxOutline];
     const int count = outline(p, c);
     Vec2 lo, hi;
     bounds(c, count, lo, hi);
-    if (!inside_cells(*grid, lo) || !inside_cells(*grid, hi)) return false;
-    if constexpr (G == Geometry::axisymmetric)
-      if (!(position[p].x() > 0.0)) return false;
+    return inside_cells(*grid, lo) && inside_cells(*grid, hi) && within_block(lo, hi);
+  }
+
+  // Whether the domain fits the 3 x 3 cells of the stencil (a domain stretched
+  // further stops the run with the reason "domain too wide").
+  bool within_stencil(std::size_t p) const {
+    Vec2 c[kMaxOutline];
+    const int count = outline(p, c);
+    Vec2 lo, hi;
+    bounds(c, count, lo, hi);
+    return within_block(lo, hi);
+  }
+
+  bool within_block(const Vec2& lo, const Vec2& hi) const {
     int i0, j0;
     block_origin(lo, *grid, i0, j0);
     return hi.x() <= i0 + block - 1 && hi.y() <= j0 + block - 1;

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <stdexcept>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -212,6 +213,10 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
     o = scene->run(request.quiet ? ProgressSink{} : progress_printer(err));
   } catch (const ConfigError& e) {
     fmt::print(err, "mpmvv run: {}\n", e.what());
+    return 2;
+  } catch (const std::invalid_argument& e) {
+    // The solver refuses a model it cannot step (make_stepper's checks).
+    fmt::print(err, "mpmvv run: {}: the solver refuses the seeded model: {}\n", request.scene_file, e.what());
     return 2;
   }
 
