@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "split.hpp"
 #include "shape/cpdi.hpp"
 #include "shape/cpdi_exact.hpp"
 #include "shape/gimp.hpp"
@@ -43,11 +44,12 @@ template <class Shape, class Material>
 class ExplicitStepper final : public Stepper {
  public:
   ExplicitStepper(Model model, Scheme scheme, Material material, SceneStages stages, double gradient_scale,
-                  bool cell_averaged)
+                  bool cell_averaged, double split_length)
       : Stepper(std::move(model)),
         scheme_(scheme),
         gradient_scale_(gradient_scale),
         cell_averaged_(cell_averaged),
+        split_length_(split_length),
         material_(material),
         body_force_(std::move(stages.body_force)),
         constraints_(std::move(stages.constraints)),
@@ -80,6 +82,12 @@ class ExplicitStepper final : public Stepper {
       case Scheme::usf: step_usf(t, dt, kick); break;
       case Scheme::musl: step_musl(t, dt, kick); break;
     }
+    // Between steps, where no stage holds the particle arrays.
+    if constexpr (Shape::reads_deformation_gradient)
+      if (split_length_ > 0.0 && split_long_domains(model_.particles, split_length_) > 0) {
+        if (scheme_ == Scheme::musl) next_position_.resize(model_.particles.size());
+        if (body_force_) body_force_->prepare(model_.particles);
+      }
   }
 
   ParticleScan scan() const override {
@@ -294,6 +302,7 @@ class ExplicitStepper final : public Stepper {
   Scheme scheme_;
   double gradient_scale_;
   bool cell_averaged_;
+  double split_length_;  // CPDI domains longer than this are split in two (split.hpp); 0: never
   std::vector<std::vector<double>> cell_volume_;  // locking remedy: per-thread cell volume sums
   Material material_;
   std::shared_ptr<BodyForce> body_force_;
@@ -318,7 +327,8 @@ std::unique_ptr<Stepper> make_for_shape(Model model, const SolverOptions& o, con
       [&](const auto& m) -> std::unique_ptr<Stepper> {
         using Material = std::decay_t<decltype(m)>;
         return std::make_unique<ExplicitStepper<Shape, Material>>(std::move(model), o.scheme, m, std::move(stages),
-                                                                 o.cpdi_gradient_scale, o.cell_averaged_dilatation);
+                                                                 o.cpdi_gradient_scale, o.cell_averaged_dilatation,
+                                                                 o.split_domains_beyond * model.grid.h);
       },
       material);
 }
@@ -367,6 +377,14 @@ std::unique_ptr<Stepper> make_stepper(Model model, const SolverOptions& options,
                                       const MaterialModel& material, SceneStages stages) {
   const std::size_t n = model.particles.size();
   if (!(stages.damping >= 0.0)) throw std::invalid_argument("damping must be zero or positive");
+  if (!(options.split_domains_beyond >= 0.0))
+    throw std::invalid_argument("split_domains_beyond must be zero (never) or a positive number of cells");
+  if (options.split_domains_beyond > 0.0) {
+    if (options.method != Method::cpdi) throw std::invalid_argument("split_domains_beyond is for method cpdi only");
+    if (options.geometry != Geometry::plane_strain)
+      throw std::invalid_argument("split_domains_beyond is plane strain only");
+    if (stages.second_body > 0) throw std::invalid_argument("split_domains_beyond serves one body only");
+  }
   if (stages.contact && !stages.contact->displacement)
     throw std::invalid_argument("a contact master needs its displacement d(t)");
   if (stages.second_body > 0) {

@@ -37,6 +37,9 @@ struct SolverOptions {
   // Volumetric locking remedy (002_c3305cb8b1bc1490.txt eqs. 1.82-1.84): after
   // each deformation update every particle takes its cell's mean dilatation.
   bool cell_averaged_dilatation = false;
+  // CPDI only: a domain longer than this many cells along one of its vectors
+  // is split in two along it after a step (split.hpp); 0: never.
+  double split_domains_beyond = 0.0;
 };
 
 // A body force supplied by the scene, per unit mass. One call fills the whole
@@ -44,9 +47,9 @@ struct SolverOptions {
 class BodyForce {
  public:
   virtual ~BodyForce() = default;
-  // Called once, with the particles the run will step (their order is fixed
-  // for the run), before the first evaluate: a force may keep per-particle
-  // factors that never change.
+  // Called with the particles the run will step before the first evaluate,
+  // and again whenever the set changes (split.hpp appends halves): a force may
+  // keep per-particle factors that hold while the set does.
   virtual void prepare(const Particles&) {}
   virtual void evaluate(double t, const Particles& particles, std::vector<Vec2>& body_force) const = 0;
 };

@@ -33,7 +33,8 @@ RunOutcome run_time_loop(Stepper& stepper, const TimeLoopOptions& options, RunOb
   RunOutcome out;
   const auto start = Clock::now();
   auto last_report = start;
-  const std::size_t n = stepper.model().particles.size();
+  // (The particle count may grow: split.hpp.)
+  auto n = [&] { return stepper.model().particles.size(); };
   const double h = stepper.model().grid.h;
   // A step this small means the signal speed has run away.
   const double smallest_step = 1e-12 * options.end_time;
@@ -52,7 +53,7 @@ RunOutcome run_time_loop(Stepper& stepper, const TimeLoopOptions& options, RunOb
   double previous_dt = 0.0;
   std::size_t next_output = 0;
   ParticleScan scan = stepper.scan();
-  if (scan.first_unhealthy < n) fail(scan, t);
+  if (scan.first_unhealthy < n()) fail(scan, t);
 
   while (out.failure_reason.empty() && next_output < options.output_times.size()) {
     double dt = options.fixed_step > 0.0 ? options.fixed_step : options.cfl * h / scan.max_signal_speed;
@@ -82,6 +83,7 @@ RunOutcome run_time_loop(Stepper& stepper, const TimeLoopOptions& options, RunOb
     const double kick = options.time_integration == TimeIntegration::symplectic_euler ? dt
                         : out.steps == 0                                              ? 0.5 * dt
                                                                                       : 0.5 * (previous_dt + dt);
+    out.particle_steps += static_cast<long long>(n());
     stepper.step(t, dt, kick);
     previous_dt = dt;
     ++out.steps;
@@ -96,7 +98,7 @@ RunOutcome run_time_loop(Stepper& stepper, const TimeLoopOptions& options, RunOb
     observer.after_step(t, stepper);
 
     scan = stepper.scan();
-    if (scan.first_unhealthy < n) {
+    if (scan.first_unhealthy < n()) {
       fail(scan, t);
       break;
     }
@@ -116,7 +118,7 @@ RunOutcome run_time_loop(Stepper& stepper, const TimeLoopOptions& options, RunOb
     if (progress && seconds_since(last_report) >= progress_interval_seconds) {
       last_report = Clock::now();
       const double elapsed = seconds_since(start);
-      const double rate = double(out.steps) * double(n) / elapsed;
+      const double rate = double(out.particle_steps) / elapsed;
       const double eta = t > 0.0 ? elapsed * (options.end_time - t) / t : 0.0;
       progress({out.steps, t, options.end_time, rate, eta, false});
     }
@@ -126,7 +128,6 @@ RunOutcome run_time_loop(Stepper& stepper, const TimeLoopOptions& options, RunOb
   out.completed = out.failure_reason.empty();
   out.wall_seconds = seconds_since(start);
   out.forcing_seconds = stepper.forcing_seconds();
-  out.particle_steps = out.steps * static_cast<long long>(n);
   if (progress) {
     const double rate = out.wall_seconds > 0.0 ? double(out.particle_steps) / out.wall_seconds : 0.0;
     progress({out.steps, t, options.end_time, rate, 0.0, true});

@@ -19,6 +19,7 @@
 #include "solver/explicit_stepper.hpp"
 #include "solver/parallel.hpp"
 #include "solver/shape/cpdi.hpp"
+#include "solver/split.hpp"
 #include "solver/time_loop.hpp"
 
 namespace {
@@ -363,6 +364,112 @@ TEST(TimeLoop, BadInitialParticleIsReportedAsData) {
       EXPECT_EQ(o.time_reached, 0.0);
       EXPECT_EQ(o.outputs_written, 0u);
     }
+}
+
+// ---------------------------------------------------------------- splitting stretched domains
+
+// Splitting (solver/split.hpp) replaces a particle by halves that tile it:
+// mass, reference volume, momentum and the first moment of mass (sum m x and
+// sum m X) are unchanged, every domain ends no longer than the limit, and
+// each half's domain corners lie on its parent's domain.
+TEST(CpdiSplit, HalvesTileTheParentAndConserveMassAndMomentum) {
+  Particles P;
+  P.resize(2);
+  P.half_size = {Vec2(0.05, 0.05), Vec2(0.05, 0.05)};
+  Mat2 shear;
+  shear << 1.0, 4.5, 0.0, 1.0;  // r_2 = (4.5, 1) l: 0.46 m long
+  Mat2 stretch;
+  stretch << 2.5, 0.3, -0.4, 0.6;
+  P.deformation_gradient = {shear, stretch};
+  P.position = {Vec2(0.2, -0.1), Vec2(-0.5, 0.7)};
+  P.reference_position = {Vec2(0.1, -0.2), Vec2(-0.4, 0.6)};
+  P.velocity = {Vec2(1.0, -2.0), Vec2(0.3, 0.25)};
+  for (std::size_t p = 0; p < 2; ++p) {
+    P.stress[p] = Mat2::Identity() * double(p + 1);
+    P.reference_volume[p] = 4.0 * 0.05 * 0.05;
+    P.volume[p] = mpmvv::determinant(P.deformation_gradient[p]) * P.reference_volume[p];
+    P.mass[p] = 1000.0 * P.reference_volume[p];
+  }
+  auto totals = [](const Particles& Q) {
+    struct {
+      double mass = 0.0, volume = 0.0;
+      Vec2 momentum = Vec2::Zero(), moment = Vec2::Zero(), reference_moment = Vec2::Zero();
+    } t;
+    for (std::size_t p = 0; p < Q.size(); ++p) {
+      t.mass += Q.mass[p];
+      t.volume += Q.volume[p];
+      t.momentum += Q.mass[p] * Q.velocity[p];
+      t.moment += Q.mass[p] * Q.position[p];
+      t.reference_moment += Q.mass[p] * Q.reference_position[p];
+    }
+    return t;
+  };
+  const auto before = totals(P);
+  const Particles parent = P;
+  const double limit = 0.12;
+  const std::size_t splits = mpmvv::split_long_domains(P, limit);
+  EXPECT_EQ(splits, P.size() - 2);
+  EXPECT_GE(splits, 4u);  // the 0.46 m shear domain alone needs two halvings
+  const auto after = totals(P);
+  EXPECT_NEAR(after.mass, before.mass, 1e-14 * before.mass);
+  EXPECT_NEAR(after.volume, before.volume, 1e-14 * before.volume);
+  EXPECT_LT((after.momentum - before.momentum).norm(), 1e-14 * before.momentum.norm());
+  EXPECT_LT((after.moment - before.moment).norm(), 1e-14);
+  EXPECT_LT((after.reference_moment - before.reference_moment).norm(), 1e-14);
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    const Mat2 s = P.deformation_gradient[p] * P.half_size[p].asDiagonal();
+    EXPECT_LE(2.0 * s.col(0).norm(), limit);
+    EXPECT_LE(2.0 * s.col(1).norm(), limit);
+    // Which parent: the one whose F it carries; the half's centre and its
+    // reference centre are on the parent's affine map, x - x_q = F (X - X_q).
+    const std::size_t q = P.deformation_gradient[p] == shear ? 0 : 1;
+    EXPECT_LT((P.position[p] - parent.position[q] -
+               parent.deformation_gradient[q] * (P.reference_position[p] - parent.reference_position[q]))
+                  .norm(),
+              1e-14);
+    EXPECT_EQ(P.velocity[p], parent.velocity[q]);
+    EXPECT_EQ(P.stress[p], parent.stress[q]);
+  }
+}
+
+// A run that splits keeps going over its growing particle set: the sheared
+// disk of the domain tests, with domains limited to half a cell, completes,
+// ends with more particles, and keeps its mass and momentum.
+TEST(CpdiSplit, RunWithSplittingCompletesAndConserves) {
+  Model model = disk_model(Method::cpdi);
+  for (std::size_t p = 0; p < model.particles.size(); ++p) {
+    const Vec2 x = model.particles.position[p];
+    model.particles.velocity[p] = Vec2(0.3 * x.y() + 0.1 * x.x(), -0.05 * x.y());
+  }
+  const std::size_t n0 = model.particles.size();
+  const Vec2 momentum = total_momentum(model.particles);
+  double mass = 0.0;
+  for (double m : model.particles.mass) mass += m;
+  SolverOptions options{Method::cpdi, Scheme::usl};
+  options.split_domains_beyond = 0.5;  // the seeded domains are exactly half a cell
+  auto stepper = mpmvv::make_stepper(std::move(model), options, MaterialModel{kSolid}, nullptr);
+  NullObserver observer;
+  const mpmvv::RunOutcome o = mpmvv::run_time_loop(*stepper, short_run(0.5), observer);
+  EXPECT_TRUE(o.completed) << o.failure_reason << " " << o.failure_detail;
+  const Particles& P = stepper->model().particles;
+  EXPECT_GT(P.size(), n0);
+  double mass_after = 0.0;
+  for (double m : P.mass) mass_after += m;
+  EXPECT_NEAR(mass_after, mass, 1e-12 * mass);
+  EXPECT_LT((total_momentum(P) - momentum).norm(), 1e-10 * total_momentum_magnitude(P));
+  EXPECT_GT(o.particle_steps, static_cast<long long>(o.steps * n0));
+}
+
+// Splitting is for CPDI in plane strain with one body.
+TEST(CpdiSplit, MakeStepperRefusesSplittingElsewhere) {
+  SolverOptions gimp{Method::gimp, Scheme::usl};
+  gimp.split_domains_beyond = 1.0;
+  EXPECT_THROW(mpmvv::make_stepper(disk_model(Method::gimp), gimp, MaterialModel{kSolid}, nullptr),
+               std::invalid_argument);
+  SolverOptions negative{Method::cpdi, Scheme::usl};
+  negative.split_domains_beyond = -1.0;
+  EXPECT_THROW(mpmvv::make_stepper(disk_model(Method::cpdi), negative, MaterialModel{kSolid}, nullptr),
+               std::invalid_argument);
 }
 
 // Exact CPDI's stencil holds 3 x 3 cells: a particle stretched beyond them

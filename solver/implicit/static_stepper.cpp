@@ -505,6 +505,8 @@ std::unique_ptr<Stepper> make_static_stepper(Model model, const SolverOptions& o
     throw std::invalid_argument(fmt::format("method {} needs a particle domain (half_size) for every particle",
                                             to_string(options.method)));
   check_domain_outlines(model.particles, options.method);
+  if (options.split_domains_beyond != 0.0)
+    throw std::invalid_argument("split_domains_beyond serves the explicit step only");
   switch (options.method) {
     case Method::linear: return make_for_shape<LinearShape>(std::move(model), material, std::move(stages), o);
     case Method::gimp: return make_for_shape<GimpShapeT<Geometry::plane_strain>>(std::move(model), material, std::move(stages), o);

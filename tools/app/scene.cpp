@@ -46,6 +46,11 @@ std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_
        "particle: each particle keeps its own det F; cell-averaged: each takes its cell's mean dilatation after every "
        "deformation update (eqs. 1.82-1.84 of the Vaango manual), the remedy for volumetric locking",
        -inf, inf, false, false, {"particle", "cell-averaged"}},
+      {"split_domains_beyond", KeyKind::real, 0.0,
+       "cpdi only: after a step, a particle whose domain is longer than this many cells along one of its vectors is "
+       "replaced by its two halves along it (0: never); keeps the corner interpolation of CPDI within a few cells "
+       "under large shear",
+       0.0, 1000.0, false, false},
       {"cells", KeyKind::integer, default_cells, "cells across the domain along each axis", 4, 20000},
       {"particles_per_direction", KeyKind::integer, std::int64_t(2),
        "particles per cell along each axis (2 means 4 per cell in 2D)", 1, 16},
@@ -75,6 +80,7 @@ SolverOptions solver_options(const Config& c) {
   const std::string& s = c.text("scheme");
   o.scheme = s == "usf" ? Scheme::usf : s == "musl" ? Scheme::musl : Scheme::usl;
   o.cell_averaged_dilatation = c.text("dilatation") == "cell-averaged";
+  o.split_domains_beyond = c.real("split_domains_beyond");
   return o;
 }
 
