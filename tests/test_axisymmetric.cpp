@@ -365,6 +365,21 @@ std::map<int, NodeFactors> cpdi_by_quadrature(const GridGeometry& grid, const Ve
   return out;
 }
 
+// A shape's weight, gradient and hoop factor for particle p, summed per node.
+template <class Shape>
+std::map<int, NodeFactors> factors_by_node(const Shape& shape, std::size_t p) {
+  Stencil<Shape::stencil_size> st;
+  shape.evaluate(p, st);
+  std::map<int, NodeFactors> out;
+  for (int k = 0; k < st.size; ++k) {
+    NodeFactors& f = out[st.node[k]];
+    f.weight += st.weight[k];
+    f.gradient += st.gradient[k];
+    f.hoop += st.hoop[k];
+  }
+  return out;
+}
+
 // CPDI's r-weighted weights, gradients and hoop factors (the closed forms in
 // solver/shape/cpdi.hpp) equal the quadrature of their definitions, node by
 // node, for sheared and stretched domains, interior and next to the axis.
@@ -378,15 +393,7 @@ TEST(AxisymmetricShape, CpdiMatchesQuadratureOverTheParallelogram) {
     const CpdiShapeT<kRz> shape = CpdiShapeT<kRz>::bind(grid, P);
     for (std::size_t p = 0; p < P.size(); ++p) {
       ASSERT_TRUE(shape.inside(p));
-      Stencil<CpdiShapeT<kRz>::stencil_size> st;
-      shape.evaluate(p, st);
-      std::map<int, NodeFactors> closed;
-      for (int k = 0; k < st.size; ++k) {
-        NodeFactors& f = closed[st.node[k]];
-        f.weight += st.weight[k];
-        f.gradient += st.gradient[k];
-        f.hoop += st.hoop[k];
-      }
+      const std::map<int, NodeFactors> closed = factors_by_node(shape, p);
       const std::map<int, NodeFactors> quadrature = cpdi_by_quadrature(grid, P.position[p], shape.domain(p));
       // Every node the quadrature reaches is in the stencil, and every stencil
       // node the quadrature does not reach carries nothing.
@@ -495,15 +502,7 @@ TEST(AxisymmetricShape, CpdiExactMatchesTheAveragesOfTheGridBasis) {
     const CpdiExactShapeT<kRz> shape = CpdiExactShapeT<kRz>::bind(grid, P);
     for (std::size_t p = 0; p < P.size(); ++p) {
       ASSERT_TRUE(shape.inside(p));
-      Stencil<CpdiExactShapeT<kRz>::stencil_size> st;
-      shape.evaluate(p, st);
-      std::map<int, NodeFactors> exact;
-      for (int k = 0; k < st.size; ++k) {
-        NodeFactors& f = exact[st.node[k]];
-        f.weight += st.weight[k];
-        f.gradient += st.gradient[k];
-        f.hoop += st.hoop[k];
-      }
+      const std::map<int, NodeFactors> exact = factors_by_node(shape, p);
       const double coarse = largest_difference(exact, rz_midpoint(grid, P.position[p], shape.domain(p), 400), grid,
                                                P.position[p].x());
       const double fine = largest_difference(exact, rz_midpoint(grid, P.position[p], shape.domain(p), 1600), grid,

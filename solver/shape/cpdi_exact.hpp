@@ -259,21 +259,23 @@ struct CpdiExactShapeT {
     if (!inside_walls(*grid, position[p])) return false;
     if constexpr (G == Geometry::axisymmetric)
       if (!(position[p].x() > 0.0)) return false;
-    Vec2 c[kMaxOutline];
-    const int count = outline(p, c);
     Vec2 lo, hi;
-    bounds(c, count, lo, hi);
+    outline_box(p, lo, hi);
     return inside_cells(*grid, lo) && inside_cells(*grid, hi) && within_block(lo, hi);
   }
 
   // Whether the domain fits the 3 x 3 cells of the stencil (a domain stretched
   // further stops the run with the reason "domain too wide").
   bool within_stencil(std::size_t p) const {
-    Vec2 c[kMaxOutline];
-    const int count = outline(p, c);
     Vec2 lo, hi;
-    bounds(c, count, lo, hi);
+    outline_box(p, lo, hi);
     return within_block(lo, hi);
+  }
+
+  // The bounding box of particle p's current outline, in grid coordinates.
+  void outline_box(std::size_t p, Vec2& lo, Vec2& hi) const {
+    Vec2 c[kMaxOutline];
+    bounds(c, outline(p, c), lo, hi);
   }
 
   bool within_block(const Vec2& lo, const Vec2& hi) const {

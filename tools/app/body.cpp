@@ -73,6 +73,24 @@ double angle_minus_sine(double theta) {
 //   beyond c towards the bulge, and sin(theta/2) = L / 2r).
 // No angle is unwrapped, so a vanishing arc (a box corner on the circle)
 // contributes nothing rather than a whole circle.
+// The circle of an arc p0 -> p1 (in coordinates about `origin`) and the arc's
+// signed angle about its centre: |sweep| <= pi (the arcs are x-monotone),
+// from atan2(|cross|, dot), accurate at any angle; its sign is the arc's
+// orientation, not the cross product's, which is ambiguous at pi.
+struct ArcSweep {
+  Vec2 centre;
+  double squared_radius;
+  double sweep;
+};
+
+ArcSweep arc_sweep(const Arc& arc, const Vec2& p0, const Vec2& p1, const Vec2& origin) {
+  const Circle circle = arc.supporting_circle();
+  const Vec2 c = Vec2(CGAL::to_double(circle.center().x()), CGAL::to_double(circle.center().y())) - origin;
+  const Vec2 a = p0 - c, b = p1 - c;
+  const double angle = std::atan2(std::abs(a.x() * b.y() - a.y() * b.x()), a.dot(b));
+  return {c, CGAL::to_double(circle.squared_radius()), arc.orientation() == CGAL::COUNTERCLOCKWISE ? angle : -angle};
+}
+
 template <class Curves>
 void add_boundary(const Curves& curves, const Vec2& origin, AreaMoments& m) {
   for (auto it = curves.curves_begin(); it != curves.curves_end(); ++it) {
@@ -84,13 +102,9 @@ void add_boundary(const Curves& curves, const Vec2& origin, AreaMoments& m) {
     m.moment_x += (y1 - y0) * (x0 * x0 + x0 * x1 + x1 * x1) / 6.0;
     m.moment_y -= (x1 - x0) * (y0 * y0 + y0 * y1 + y1 * y1) / 6.0;
     if (arc.is_linear()) continue;
-    const Circle circle = arc.supporting_circle();
-    const Vec2 c = Vec2(CGAL::to_double(circle.center().x()), CGAL::to_double(circle.center().y())) - origin;
-    const double r2 = CGAL::to_double(circle.squared_radius());
-    const Vec2 a = p0 - c, b = p1 - c, d = p1 - p0;
-    const double theta = std::atan2(std::abs(a.x() * b.y() - a.y() * b.x()), a.dot(b));
-    const double sign = arc.orientation() == CGAL::COUNTERCLOCKWISE ? 1.0 : -1.0;
-    const double segment = sign * 0.5 * r2 * angle_minus_sine(theta);
+    const ArcSweep s = arc_sweep(arc, p0, p1, origin);
+    const Vec2 c = s.centre, d = p1 - p0;
+    const double segment = std::copysign(0.5 * s.squared_radius * angle_minus_sine(std::abs(s.sweep)), s.sweep);
     m.area += segment;
     m.moment_x += segment * c.x() + d.squaredNorm() / 12.0 * d.y();
     m.moment_y += segment * c.y() - d.squaredNorm() / 12.0 * d.x();
@@ -294,14 +308,9 @@ void append_outline(const Curves& curves, double max_chord, std::vector<Vec2>& o
     const Vec2 p1(value(arc.target(), 0), value(arc.target(), 1));
     out.push_back(p0);
     if (arc.is_linear()) continue;
-    const Circle circle = arc.supporting_circle();
-    const Vec2 c(CGAL::to_double(circle.center().x()), CGAL::to_double(circle.center().y()));
-    const double r = std::sqrt(CGAL::to_double(circle.squared_radius()));
-    const Vec2 a = p0 - c, b = p1 - c;
-    // |sweep| <= pi (the arcs are x-monotone); its sign is the arc's
-    // orientation, not the cross product's, which is ambiguous at pi.
-    const double sweep = (arc.orientation() == CGAL::COUNTERCLOCKWISE ? 1.0 : -1.0) *
-                         std::atan2(std::abs(a.x() * b.y() - a.y() * b.x()), a.dot(b));
+    const ArcSweep s = arc_sweep(arc, p0, p1, Vec2::Zero());
+    const Vec2 c = s.centre, a = p0 - c;
+    const double r = std::sqrt(s.squared_radius), sweep = s.sweep;
     const int chords = std::max(1, int(std::ceil(std::abs(sweep) * r / max_chord)));
     const double start = std::atan2(a.y(), a.x());
     for (int k = 1; k < chords; ++k) {
@@ -313,6 +322,14 @@ void append_outline(const Curves& curves, double max_chord, std::vector<Vec2>& o
 
 }  // namespace
 
+void append_ring(std::vector<Vec2>& chain, const std::vector<Vec2>& ring) {
+  if (ring.empty()) return;
+  const bool bridged = !chain.empty();
+  if (bridged) chain.push_back(chain.front());
+  chain.insert(chain.end(), ring.begin(), ring.end());
+  if (bridged) chain.push_back(ring.front());
+}
+
 std::vector<Vec2> Body::clip_outline(const Vec2& lower, const Vec2& upper, double max_chord) const {
   if (!(max_chord > 0.0)) throw std::invalid_argument("an outline needs a positive chord length");
   PolygonSet set = impl_->set;
@@ -323,13 +340,7 @@ std::vector<Vec2> Body::clip_outline(const Vec2& lower, const Vec2& upper, doubl
   auto add_ring = [&](const auto& ring) {
     std::vector<Vec2> points;
     append_outline(ring, max_chord, points);
-    if (points.empty()) return;
-    // A later ring hangs off the chain's first point: back to it (which
-    // closes the ring before), over to the new ring, round it and closed; the
-    // chain's own closing edge is the bridge back.
-    if (!outline.empty()) outline.push_back(outline.front());
-    outline.insert(outline.end(), points.begin(), points.end());
-    if (outline.size() > points.size()) outline.push_back(points.front());
+    append_ring(outline, points);
   };
   for (const PolygonWithHoles& p : pieces) {
     add_ring(p.outer_boundary());

@@ -21,6 +21,13 @@ struct AreaMoments {
   Vec2 centroid() const { return Vec2(moment_x, moment_y) / area; }
 };
 
+// Appends a closed ring of points to a chain of rings (one outline): the ring
+// hangs off the chain's first point - back to it (which closes the ring
+// before), over to the new ring, round it and closed; the chain's own closing
+// edge is the bridge back. Walked both ways, a bridge adds nothing to any
+// integral over the region by Green's theorem.
+void append_ring(std::vector<Vec2>& chain, const std::vector<Vec2>& ring);
+
 class Body {
  public:
   static Body rectangle(const Vec2& lower, const Vec2& upper);

@@ -344,8 +344,8 @@ class MmsCase final : public SceneCase, private RunObserver {
   bool outlines() const { return options_.method == Method::cpdi_exact && exact_seeding_; }
 
   // The outline of a piece and a sliver joined to it: a whole sub-cell's
-  // square where either has none, then the sliver's ring on a bridge from the
-  // first point (walked there and back, it adds nothing to any integral).
+  // square where either has none, then the sliver's ring on a bridge
+  // (append_ring).
   static std::vector<Vec2> joined_outline(const Piece& piece, const Piece& sliver, double spacing) {
     auto ring = [&](const Piece& q) {
       if (!q.outline.empty()) return q.outline;
@@ -353,10 +353,7 @@ class MmsCase final : public SceneCase, private RunObserver {
       return std::vector<Vec2>{lo, Vec2(hi.x(), lo.y()), hi, Vec2(lo.x(), hi.y())};
     };
     std::vector<Vec2> out = ring(piece);
-    const std::vector<Vec2> other = ring(sliver);
-    out.push_back(out.front());
-    out.insert(out.end(), other.begin(), other.end());
-    out.push_back(other.front());
+    append_ring(out, ring(sliver));
     return out;
   }
 
