@@ -44,12 +44,14 @@ template <class Shape, class Material>
 class ExplicitStepper final : public Stepper {
  public:
   ExplicitStepper(Model model, Scheme scheme, Material material, SceneStages stages, double gradient_scale,
-                  bool cell_averaged, double split_length)
+                  Dilatation dilatation, double split_length, double viscosity_linear, double viscosity_quadratic)
       : Stepper(std::move(model)),
         scheme_(scheme),
         gradient_scale_(gradient_scale),
-        cell_averaged_(cell_averaged),
+        dilatation_(dilatation),
         split_length_(split_length),
+        viscosity_linear_(viscosity_linear),
+        viscosity_quadratic_(viscosity_quadratic),
         material_(material),
         body_force_(std::move(stages.body_force)),
         constraints_(std::move(stages.constraints)),
@@ -62,7 +64,7 @@ class ExplicitStepper final : public Stepper {
       model_.particles.body_force.assign(model_.particles.size(), Vec2::Zero());
     }
     if (scheme_ == Scheme::musl) next_position_.resize(model_.particles.size());
-    if (cell_averaged_) cell_volume_.resize(std::size_t(max_threads()));
+    if (dilatation_ != Dilatation::particle) volume_sums_.resize(std::size_t(max_threads()));
     if (damping_ > 0.0) {
       fixed_components_.assign(2 * model_.grid.node_count(), 0);
       for (const NodeConstraint& c : constraints_)
@@ -90,8 +92,13 @@ class ExplicitStepper final : public Stepper {
       }
   }
 
+  // With bulk viscosity the fastest grid mode is damped at the ratio xi of the
+  // last step, and central differences are stable to dt = (2 / omega)
+  // (sqrt(1 + xi^2) - xi): the signal speed grows by sqrt(1 + xi^2) + xi.
   ParticleScan scan() const override {
-    return scan_particles(bind(model_.particles), material_, model_.particles);
+    ParticleScan s = scan_particles(bind(model_.particles), material_, model_.particles);
+    if (viscous()) s.max_signal_speed *= std::sqrt(1.0 + viscous_ratio_ * viscous_ratio_) + viscous_ratio_;
+    return s;
   }
 
   Monitors monitors() const override {
@@ -135,8 +142,9 @@ class ExplicitStepper final : public Stepper {
     map_mass_momentum_and_forces(shape, t);
     advance_grid(shape, t, dt, kick);
     move_tracers(dt);
+    remember_volumes();
     grid_to_particles<kVelocity | kPosition | kDeformation, Shape>(shape, fields_, P, dt, kick);
-    update_stress_of_particles();
+    update_stress_of_particles(dt);
     book_body_work(dt);
   }
 
@@ -171,9 +179,10 @@ class ExplicitStepper final : public Stepper {
     if (!constraints_.empty()) book_constraint_work(t, dt);
     apply_body_contact(fields_, fields_b_, gradient_a_, gradient_b_, kick, contact_forces_);
     move_tracers(dt);
+    remember_volumes();
     grid_to_particles<kVelocity | kPosition | kDeformation, Shape>(shape, fields_, P, dt, kick, nullptr, a);
     grid_to_particles<kVelocity | kPosition | kDeformation, Shape>(shape, fields_b_, P, dt, kick, nullptr, b);
-    update_stress_of_particles();
+    update_stress_of_particles(dt);
     book_body_work(dt);
   }
 
@@ -194,8 +203,9 @@ class ExplicitStepper final : public Stepper {
     grid_velocity_from_momentum(fields_);
     apply_walls(model_.grid, fields_);
     if (!constraints_.empty()) apply_constraints(constraints_, t, dt, kick, fields_);
+    remember_volumes();
     grid_to_particles<kDeformation, Shape>(shape, fields_, P, dt, kick);
-    update_stress_of_particles();
+    update_stress_of_particles(dt);
     if (body_force_) {
       evaluate_body_force(t);
       particles_to_grid<kInternalForce | kBodyForce>(shape, P, buffers_, fields_);
@@ -221,9 +231,10 @@ class ExplicitStepper final : public Stepper {
     grid_velocity_from_momentum(fields_);
     apply_walls(model_.grid, fields_);
     if (!constraints_.empty()) apply_constraints(constraints_, t, dt, kick, fields_);
+    remember_volumes();
     grid_to_particles<kDeformation, Shape>(shape, fields_, P, dt, kick);
     P.position.swap(next_position_);
-    update_stress_of_particles();
+    update_stress_of_particles(dt);
     book_body_work(dt);
   }
 
@@ -241,11 +252,29 @@ class ExplicitStepper final : public Stepper {
     }
   }
 
-  // The constitutive update, after the locking remedy when the run has it.
-  void update_stress_of_particles() {
+  // The constitutive update, after the locking remedy when the run has it,
+  // then the bulk viscosity of the step's dilatation when it has that.
+  void update_stress_of_particles(double dt) {
     Particles& P = model_.particles;
-    if (cell_averaged_) average_cell_dilatation<Shape::geometry>(model_.grid, P, cell_volume_);
+    if (dilatation_ == Dilatation::cell_averaged) average_cell_dilatation<Shape::geometry>(model_.grid, P, volume_sums_);
+    if (dilatation_ == Dilatation::node_smoothed)
+      smooth_node_dilatation(bind(P), P, volume_sums_, model_.grid.node_count());
     update_stress<Shape::geometry>(material_, P);
+    if (viscous()) {
+      const ViscousStep v = add_bulk_viscosity<Shape::geometry>(P, volume_before_, material_.p_wave_modulus(),
+                                                                model_.grid.h, viscosity_linear_,
+                                                                viscosity_quadratic_, dt);
+      ledger_.damping -= v.dissipated;
+      viscous_ratio_ = v.max_ratio;
+    }
+  }
+
+  bool viscous() const { return viscosity_linear_ > 0.0 || viscosity_quadratic_ > 0.0; }
+
+  // The volumes before a deformation update, from which the bulk viscosity
+  // takes the step's dilatation.
+  void remember_volumes() {
+    if (viscous()) volume_before_ = model_.particles.volume;
   }
 
   // a_g and v_g^L from the node sums (eqs. 1.71-1.72), with the scene's damping
@@ -301,9 +330,12 @@ class ExplicitStepper final : public Stepper {
 
   Scheme scheme_;
   double gradient_scale_;
-  bool cell_averaged_;
+  Dilatation dilatation_;
   double split_length_;  // CPDI domains longer than this are split in two (split.hpp); 0: never
-  std::vector<std::vector<double>> cell_volume_;  // locking remedy: per-thread cell volume sums
+  double viscosity_linear_, viscosity_quadratic_;  // bulk viscosity C0, C1 (add_bulk_viscosity); 0: none
+  double viscous_ratio_ = 0.0;                     // its damping ratio in the last step
+  std::vector<double> volume_before_;              // with bulk viscosity: V_p before the deformation update
+  std::vector<std::vector<double>> volume_sums_;  // dilatation remedies: per-thread cell or node volume sums
   Material material_;
   std::shared_ptr<BodyForce> body_force_;
   std::vector<NodeConstraint> constraints_;
@@ -327,8 +359,9 @@ std::unique_ptr<Stepper> make_for_shape(Model model, const SolverOptions& o, con
       [&](const auto& m) -> std::unique_ptr<Stepper> {
         using Material = std::decay_t<decltype(m)>;
         return std::make_unique<ExplicitStepper<Shape, Material>>(std::move(model), o.scheme, m, std::move(stages),
-                                                                 o.cpdi_gradient_scale, o.cell_averaged_dilatation,
-                                                                 o.split_domains_beyond * model.grid.h);
+                                                                 o.cpdi_gradient_scale, o.dilatation,
+                                                                 o.split_domains_beyond * model.grid.h,
+                                                                 o.bulk_viscosity_linear, o.bulk_viscosity_quadratic);
       },
       material);
 }
@@ -385,6 +418,8 @@ std::unique_ptr<Stepper> make_stepper(Model model, const SolverOptions& options,
       throw std::invalid_argument("split_domains_beyond is plane strain only");
     if (stages.second_body > 0) throw std::invalid_argument("split_domains_beyond serves one body only");
   }
+  if (!(options.bulk_viscosity_linear >= 0.0 && options.bulk_viscosity_quadratic >= 0.0))
+    throw std::invalid_argument("the bulk viscosity coefficients must be zero (none) or positive");
   if (stages.contact && !stages.contact->displacement)
     throw std::invalid_argument("a contact master needs its displacement d(t)");
   if (stages.second_body > 0) {

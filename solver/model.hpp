@@ -19,6 +19,10 @@ namespace mpmvv {
 
 enum class Method { linear, gimp, cpdi, cpdi_exact };
 enum class Scheme { usl, usf, musl };
+// What each particle's J is after a deformation update: its own det F, its
+// cell's mean (average_cell_dilatation, eqs. 1.82-1.84), or the mean its
+// nodes hold (smooth_node_dilatation); stages.hpp.
+enum class Dilatation { particle, cell_averaged, node_smoothed };
 
 const char* to_string(Method m);
 const char* to_string(Scheme s);
@@ -34,12 +38,15 @@ struct SolverOptions {
   // (MPMVV_FAULT=cpdi-gradient): the CPDI gradients are scaled by this factor.
   // 1 in every real run.
   double cpdi_gradient_scale = 1.0;
-  // Volumetric locking remedy (002_c3305cb8b1bc1490.txt eqs. 1.82-1.84): after
-  // each deformation update every particle takes its cell's mean dilatation.
-  bool cell_averaged_dilatation = false;
+  Dilatation dilatation = Dilatation::particle;
   // CPDI only: a domain longer than this many cells along one of its vectors
   // is split in two along it after a step (split.hpp); 0: never.
   double split_domains_beyond = 0.0;
+  // Artificial bulk viscosity (002_c3305cb8b1bc1490.txt eqs. 1.66-1.67,
+  // add_bulk_viscosity in stages.hpp): the linear and quadratic coefficients
+  // C0 and C1; both 0: none.
+  double bulk_viscosity_linear = 0.0;
+  double bulk_viscosity_quadratic = 0.0;
 };
 
 // A body force supplied by the scene, per unit mass. One call fills the whole

@@ -19,7 +19,8 @@ namespace mpmvv {
 // Work done on the particles since t = 0 by what the scene adds [J per unit
 // depth; per radian in r-z]: body forces and tractions (sum m b.v dt), node
 // constraints (reaction times prescribed increment), contact (sum f.v dt at
-// the nodes in contact) and grid damping (negative).
+// the nodes in contact), and grid damping and bulk viscosity (negative: what
+// they dissipate).
 struct EnergyLedger {
   double body = 0.0, constraints = 0.0, contact = 0.0, damping = 0.0;
   double total() const { return body + constraints + contact + damping; }

@@ -303,6 +303,62 @@ void average_cell_dilatation(const GridGeometry& grid, Particles& P, std::vector
   }
 }
 
+// The same remedy with the grid's nodes in place of cells and the method's
+// own weights in place of "the cell holding the centre": each node takes
+// J_g = sum_p S_gp V_p / sum_p S_gp V_p0 (eqs. 1.82-1.83 with S_gp as the
+// share of a particle a node holds), each particle reads back
+// Jbar_p = sum_g S_gp J_g and is scaled to it as in eq. 1.84. A dilatation
+// that varies from particle to particle within a node's reach, which the
+// grid cannot push back on, is smoothed away; one the grid resolves is kept
+// to second order. `node_volume` holds two sums per node, per thread.
+template <class Shape>
+void smooth_node_dilatation(const Shape& shape, Particles& P, std::vector<std::vector<double>>& node_volume,
+                            std::size_t nodes) {
+  constexpr Geometry G = Shape::geometry;
+  const std::size_t n = P.size();
+  const int threads = int(node_volume.size());
+#pragma omp parallel num_threads(threads)
+  {
+    std::vector<double>& own = node_volume[std::size_t(thread_id())];
+    own.assign(2 * nodes, 0.0);
+    Stencil<Shape::stencil_size> s;
+#pragma omp for schedule(static)
+    for (std::size_t p = 0; p < n; ++p) {
+      shape.evaluate(p, s);
+      for (int k = 0; k < Shape::stencil_size; ++k) {
+        own[2 * std::size_t(s.node[k])] += s.weight[k] * P.reference_volume[p];
+        own[2 * std::size_t(s.node[k]) + 1] += s.weight[k] * P.volume[p];
+      }
+    }
+#pragma omp for schedule(static)
+    for (std::size_t i = 0; i < 2 * nodes; ++i)
+      for (int t = 1; t < threads; ++t) node_volume[0][i] += node_volume[std::size_t(t)][i];
+    const std::vector<double>& sums = node_volume[0];
+#pragma omp for schedule(static)
+    for (std::size_t p = 0; p < n; ++p) {
+      shape.evaluate(p, s);
+      double J_bar = 0.0, weight = 0.0;
+      for (int k = 0; k < Shape::stencil_size; ++k) {
+        const std::size_t i = std::size_t(s.node[k]);
+        if (!(sums[2 * i] > 0.0)) continue;
+        J_bar += s.weight[k] * sums[2 * i + 1] / sums[2 * i];
+        weight += s.weight[k];
+      }
+      J_bar /= weight;
+      const double J = P.volume[p] / P.reference_volume[p];
+      if (!(J > 0.0 && J_bar > 0.0)) continue;  // the health scan reports it
+      if constexpr (G == Geometry::axisymmetric) {
+        const double scale = std::cbrt(J_bar / J);
+        P.deformation_gradient[p] *= scale;
+        P.hoop_stretch[p] *= scale;
+      } else {
+        P.deformation_gradient[p] *= std::sqrt(J_bar / J);
+      }
+      P.volume[p] = J_bar * P.reference_volume[p];
+    }
+  }
+}
+
 // ---------------------------------------------------------------- constitutive update
 
 template <Geometry G, class Material>
@@ -319,6 +375,60 @@ void update_stress(const Material& material, Particles& P) {
 #pragma omp parallel for schedule(static)
     for (std::size_t p = 0; p < n; ++p) P.stress[p] = material.cauchy_stress(P.deformation_gradient[p]);
   }
+}
+
+// ---------------------------------------------------------------- bulk viscosity
+
+// The artificial bulk viscosity of 002_c3305cb8b1bc1490.txt eqs. 1.66-1.67,
+// sigma_p <- sigma_p - q_p I, with
+//   q_p = -rho_p l_p (C0 c_p + C1 l_p |tr d_p|) tr d_p,
+// c_p = sqrt(M / rho_p) the p-wave speed (eq. 1.66 writes sqrt(K / rho); the
+// coefficient takes up the ratio) and tr d_p the particle's rate of
+// dilatation over the step, ln(V_p / V_p_before) / dt. Eq. 1.66 puts |tr d| in
+// the linear term, which would make q a pressure in expansion too; here q
+// takes the sign of -tr d, so the stress power -q tr d V_p =
+// rho l (C0 c + C1 l |tr d|) (tr d)^2 V_p is never negative: it dissipates in
+// compression and expansion alike. A motion that keeps volume (the ring's,
+// J = 1) feels it only through the dilatation the method gets wrong. In r-z
+// the hoop stress takes the same -q.
+// The length l_p is the particle's own thinnest width, the area of its domain
+// over its longest side (at most the cell size h; h for linear MPM, which has
+// no domain). Eq. 1.66 suggests h; but a viscous stress is stable only to a
+// step that shrinks with the square of the width its gradients act across,
+// and a sheared CPDI domain grows thin: with l = h the ring at A = 1 on 256
+// cells, which completes without viscosity, stopped with nan at t = 0.315 s
+// (C0 = 0.2) and 0.398 s (C0 = 0.05).
+struct ViscousStep {
+  double dissipated = 0.0;  // sum_p -q_p tr d_p V_p dt >= 0 [J per unit depth]
+  double max_ratio = 0.0;   // max_p C0 + C1 l_p |tr d_p| / c_p, the damping ratio xi of the fastest mode
+};
+
+template <Geometry G>
+ViscousStep add_bulk_viscosity(Particles& P, const std::vector<double>& volume_before, double wave_modulus, double h,
+                               double c0, double c1, double dt) {
+  const std::size_t n = P.size();
+  const bool has_domain = !P.half_size.empty();
+  double dissipated = 0.0, max_ratio = 0.0;
+#pragma omp parallel for schedule(static) reduction(+ : dissipated) reduction(max : max_ratio)
+  for (std::size_t p = 0; p < n; ++p) {
+    const double rate = std::log(P.volume[p] / volume_before[p]) / dt;
+    if (!std::isfinite(rate)) continue;  // the health scan reports the particle
+    double l = h;
+    if (has_domain) {  // the domain spans F_p diag(2 l_p): area over longest side
+      const Vec2 r1 = P.deformation_gradient[p].col(0) * P.half_size[p].x();
+      const Vec2 r2 = P.deformation_gradient[p].col(1) * P.half_size[p].y();
+      l = std::min(h, 2.0 * std::abs(r1.x() * r2.y() - r1.y() * r2.x()) / std::max(r1.norm(), r2.norm()));
+    }
+    const double density = P.mass[p] / P.volume[p];
+    const double c = std::sqrt(wave_modulus / density);
+    const double q = -density * l * (c0 * c + c1 * l * std::abs(rate)) * rate;
+    P.stress[p](0, 0) -= q;
+    P.stress[p](1, 1) -= q;
+    if constexpr (G == Geometry::axisymmetric) P.hoop_stress[p] -= q;
+    dissipated += -q * rate * P.volume[p] * dt;
+    max_ratio = std::max(max_ratio, c0 + c1 * l * std::abs(rate) / c);
+  }
+  return {dissipated, max_ratio};
 }
 
 // ---------------------------------------------------------------- tracers

@@ -507,6 +507,10 @@ std::unique_ptr<Stepper> make_static_stepper(Model model, const SolverOptions& o
   check_domain_outlines(model.particles, options.method);
   if (options.split_domains_beyond != 0.0)
     throw std::invalid_argument("split_domains_beyond serves the explicit step only");
+  if (options.dilatation != Dilatation::particle)
+    throw std::invalid_argument("the dilatation remedies (cell-averaged, node-smoothed) serve the explicit step only");
+  if (options.bulk_viscosity_linear != 0.0 || options.bulk_viscosity_quadratic != 0.0)
+    throw std::invalid_argument("bulk viscosity serves the explicit step only (a static step has no rate)");
   switch (options.method) {
     case Method::linear: return make_for_shape<LinearShape>(std::move(model), material, std::move(stages), o);
     case Method::gimp: return make_for_shape<GimpShapeT<Geometry::plane_strain>>(std::move(model), material, std::move(stages), o);

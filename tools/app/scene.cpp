@@ -44,13 +44,23 @@ std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_
        -inf, inf, false, false, {"central-difference", "symplectic-euler"}},
       {"dilatation", KeyKind::text, std::string("particle"),
        "particle: each particle keeps its own det F; cell-averaged: each takes its cell's mean dilatation after every "
-       "deformation update (eqs. 1.82-1.84 of the Vaango manual), the remedy for volumetric locking",
-       -inf, inf, false, false, {"particle", "cell-averaged"}},
+       "deformation update (eqs. 1.82-1.84 of the Vaango manual), the remedy for volumetric locking; node-smoothed: "
+       "each takes the mean dilatation of the nodes it reaches, with the method's weights (removes a J that varies "
+       "from particle to particle, which the grid cannot push back on)",
+       -inf, inf, false, false, {"particle", "cell-averaged", "node-smoothed"}},
       {"split_domains_beyond", KeyKind::real, 0.0,
        "cpdi only: after a step, a particle whose domain is longer than this many cells along one of its vectors is "
        "replaced by its two halves along it (0: never); keeps the corner interpolation of CPDI within a few cells "
        "under large shear",
        0.0, 1000.0, false, false},
+      {"bulk_viscosity", KeyKind::real, 0.0,
+       "linear artificial bulk viscosity C0 (eq. 1.66 of the Vaango manual; 0.2 is typical, 0: none): a stress "
+       "rho l C0 c tr(d) I, l the particle's thinnest width (at most h), that damps the particles' dilatation rate in "
+       "compression and expansion",
+       0.0, 10.0, false, false},
+      {"bulk_viscosity_quadratic", KeyKind::real, 0.0,
+       "quadratic artificial bulk viscosity C1 (eq. 1.66; 2.0 is typical, 0: none): adds rho l^2 C1 |tr d| tr(d) I",
+       0.0, 100.0, false, false},
       {"cells", KeyKind::integer, default_cells, "cells across the domain along each axis", 4, 20000},
       {"particles_per_direction", KeyKind::integer, std::int64_t(2),
        "particles per cell along each axis (2 means 4 per cell in 2D)", 1, 16},
@@ -79,8 +89,13 @@ SolverOptions solver_options(const Config& c) {
                              : Method::cpdi_exact;
   const std::string& s = c.text("scheme");
   o.scheme = s == "usf" ? Scheme::usf : s == "musl" ? Scheme::musl : Scheme::usl;
-  o.cell_averaged_dilatation = c.text("dilatation") == "cell-averaged";
+  const std::string& d = c.text("dilatation");
+  o.dilatation = d == "cell-averaged"   ? Dilatation::cell_averaged
+                 : d == "node-smoothed" ? Dilatation::node_smoothed
+                                        : Dilatation::particle;
   o.split_domains_beyond = c.real("split_domains_beyond");
+  o.bulk_viscosity_linear = c.real("bulk_viscosity");
+  o.bulk_viscosity_quadratic = c.real("bulk_viscosity_quadratic");
   return o;
 }
 
