@@ -254,6 +254,24 @@ void grid_to_particles(const Shape& shape, const GridFields& g, Particles& P, do
 
 // ---------------------------------------------------------------- locking remedy
 
+// Scales particle p's F to the dilatation J_target, F_p <- (J_target / J_p)^(1/d) F_p
+// (eq. 1.84 with d = 2 for the in-plane block; in r-z the hoop stretch takes its
+// share, d = 3), and sets V_p = J_target V_p0. The isochoric part of F is kept.
+// A particle with no positive J is left to the health scan.
+template <Geometry G>
+void scale_to_dilatation(Particles& P, std::size_t p, double J_target) {
+  const double J = P.volume[p] / P.reference_volume[p];
+  if (!(J > 0.0 && J_target > 0.0)) return;
+  if constexpr (G == Geometry::axisymmetric) {
+    const double scale = std::cbrt(J_target / J);
+    P.deformation_gradient[p] *= scale;
+    P.hoop_stretch[p] *= scale;
+  } else {
+    P.deformation_gradient[p] *= std::sqrt(J_target / J);
+  }
+  P.volume[p] = J_target * P.reference_volume[p];
+}
+
 // The cell-averaged dilatation of 002_c3305cb8b1bc1490.txt eqs. 1.82-1.84: in
 // each cell c (by the particles' centres), V_c0 = sum V_p0 and V_c = sum V_p
 // give J_c = V_c / V_c0 (eqs. 1.82-1.83), and each particle's F is scaled to
@@ -289,16 +307,7 @@ void average_cell_dilatation(const GridGeometry& grid, Particles& P, std::vector
     for (std::size_t p = 0; p < n; ++p) {
       const std::size_t c = cell_of(p);
       const double J_cell = cell_volume[0][2 * c + 1] / cell_volume[0][2 * c];
-      const double J = P.volume[p] / P.reference_volume[p];
-      if (!(J > 0.0 && J_cell > 0.0)) continue;  // the health scan reports it
-      if constexpr (G == Geometry::axisymmetric) {
-        const double scale = std::cbrt(J_cell / J);
-        P.deformation_gradient[p] *= scale;
-        P.hoop_stretch[p] *= scale;
-      } else {
-        P.deformation_gradient[p] *= std::sqrt(J_cell / J);
-      }
-      P.volume[p] = J_cell * P.reference_volume[p];
+      scale_to_dilatation<G>(P, p, J_cell);
     }
   }
 }
@@ -345,16 +354,7 @@ void smooth_node_dilatation(const Shape& shape, Particles& P, std::vector<std::v
         weight += s.weight[k];
       }
       J_bar /= weight;
-      const double J = P.volume[p] / P.reference_volume[p];
-      if (!(J > 0.0 && J_bar > 0.0)) continue;  // the health scan reports it
-      if constexpr (G == Geometry::axisymmetric) {
-        const double scale = std::cbrt(J_bar / J);
-        P.deformation_gradient[p] *= scale;
-        P.hoop_stretch[p] *= scale;
-      } else {
-        P.deformation_gradient[p] *= std::sqrt(J_bar / J);
-      }
-      P.volume[p] = J_bar * P.reference_volume[p];
+      scale_to_dilatation<G>(P, p, J_bar);
     }
   }
 }
