@@ -98,10 +98,11 @@ struct CpdiShapeT {
     if constexpr (G == Geometry::axisymmetric)
       if (!(position[p].x() > 0.0)) return false;
     if (!inside_walls(*grid, position[p])) return false;
-    const Mat2 s = domain(p);
-    for (int c = 0; c < 4; ++c)
-      if (!inside_cells(*grid, grid_coordinate(*grid, corner(p, s, c)))) return false;
-    return true;
+    // The corners x_p +- r_1 +- r_2 reach |r_1| + |r_2| along each axis: their
+    // bounding box, without forming the four corners (the scan runs every step).
+    const Vec2 reach = domain(p).cwiseAbs().rowwise().sum();
+    return inside_cells(*grid, grid_coordinate(*grid, position[p] - reach)) &&
+           inside_cells(*grid, grid_coordinate(*grid, position[p] + reach));
   }
 };
 
