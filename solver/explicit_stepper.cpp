@@ -261,9 +261,8 @@ class ExplicitStepper final : public Stepper {
       smooth_node_dilatation(bind(P), P, volume_sums_, model_.grid.node_count());
     update_stress<Shape::geometry>(material_, P);
     if (viscous()) {
-      const ViscousStep v = add_bulk_viscosity<Shape::geometry>(P, volume_before_, material_.p_wave_modulus(),
-                                                                model_.grid.h, viscosity_linear_,
-                                                                viscosity_quadratic_, dt);
+      const ViscousStep v = add_bulk_viscosity(bind(P), P, volume_before_, material_.p_wave_modulus(), model_.grid.h,
+                                               viscosity_linear_, viscosity_quadratic_, dt);
       ledger_.damping -= v.dissipated;
       viscous_ratio_ = v.max_ratio;
     }

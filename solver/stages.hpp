@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <type_traits>
 #include <vector>
 
 #include "geometry.hpp"
@@ -391,9 +392,9 @@ void update_stress(const Material& material, Particles& P) {
 // compression and expansion alike. A motion that keeps volume (the ring's,
 // J = 1) feels it only through the dilatation the method gets wrong. In r-z
 // the hoop stress takes the same -q.
-// The length l_p is the particle's own thinnest width, the area of its domain
-// over its longest side (at most the cell size h; h for linear MPM, which has
-// no domain). Eq. 1.66 suggests h; but a viscous stress is stable only to a
+// The length l_p is the particle's own thinnest width, the area of the
+// method's domain (shape.domain, as the monitors read it) over its longest
+// side (at most the cell size h; h for linear MPM, which has no domain). Eq. 1.66 suggests h; but a viscous stress is stable only to a
 // step that shrinks with the square of the width its gradients act across,
 // and a sheared CPDI domain grows thin: with l = h the ring at A = 1 on 256
 // cells, which completes without viscosity, stopped with nan at t = 0.315 s
@@ -403,21 +404,21 @@ struct ViscousStep {
   double max_ratio = 0.0;   // max_p C0 + C1 l_p |tr d_p| / c_p, the damping ratio xi of the fastest mode
 };
 
-template <Geometry G>
-ViscousStep add_bulk_viscosity(Particles& P, const std::vector<double>& volume_before, double wave_modulus, double h,
-                               double c0, double c1, double dt) {
+template <class Shape>
+ViscousStep add_bulk_viscosity(const Shape& shape, Particles& P, const std::vector<double>& volume_before,
+                               double wave_modulus, double h, double c0, double c1, double dt) {
+  constexpr Geometry G = Shape::geometry;
+  constexpr bool has_domain = !std::is_same_v<Shape, LinearShapeT<G>>;
   const std::size_t n = P.size();
-  const bool has_domain = !P.half_size.empty();
   double dissipated = 0.0, max_ratio = 0.0;
 #pragma omp parallel for schedule(static) reduction(+ : dissipated) reduction(max : max_ratio)
   for (std::size_t p = 0; p < n; ++p) {
     const double rate = std::log(P.volume[p] / volume_before[p]) / dt;
     if (!std::isfinite(rate)) continue;  // the health scan reports the particle
     double l = h;
-    if (has_domain) {  // the domain spans F_p diag(2 l_p): area over longest side
-      const Vec2 r1 = P.deformation_gradient[p].col(0) * P.half_size[p].x();
-      const Vec2 r2 = P.deformation_gradient[p].col(1) * P.half_size[p].y();
-      l = std::min(h, 2.0 * std::abs(r1.x() * r2.y() - r1.y() * r2.x()) / std::max(r1.norm(), r2.norm()));
+    if constexpr (has_domain) {  // the method's domain, half-vectors r1, r2: area over longest side
+      const Mat2 s = shape.domain(p);
+      l = std::min(h, 2.0 * std::abs(determinant(s)) / std::max(s.col(0).norm(), s.col(1).norm()));
     }
     const double density = P.mass[p] / P.volume[p];
     const double c = std::sqrt(wave_modulus / density);
