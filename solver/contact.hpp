@@ -84,7 +84,7 @@ void node_contact_gaps(const RigidBody& master, const Shape& shape, const Partic
   for (std::size_t p = 0; p < n; ++p) {
     if (scratch.particle_gap[p] > reach) continue;
     shape.evaluate(p, st);
-    for (int k = 0; k < Shape::stencil_size; ++k)
+    for (int k = 0; k < st.count; ++k)
       if (st.weight[k] > 0.0)
         scratch.node_gap[std::size_t(st.node[k])] = std::min(scratch.node_gap[std::size_t(st.node[k])], scratch.particle_gap[p]);
   }
@@ -139,7 +139,7 @@ void mass_gradient_to_grid(const Shape& shape, const Particles& P, std::size_t f
 #pragma omp for schedule(static)
     for (std::size_t p = first; p < last; ++p) {
       shape.evaluate(p, s);
-      for (int k = 0; k < Shape::stencil_size; ++k) own[std::size_t(s.node[k])] += P.mass[p] * s.gradient[k];
+      for (int k = 0; k < s.count; ++k) own[std::size_t(s.node[k])] += P.mass[p] * s.gradient[k];
     }
 #pragma omp for schedule(static)
     for (std::size_t i = 0; i < nodes; ++i) {

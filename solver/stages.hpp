@@ -90,7 +90,7 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
       if constexpr (with_body) body = m * P.body_force[p];
       if constexpr (with_internal) volume_stress = P.volume[p] * P.stress[p];
       if constexpr (with_internal && axisymmetric) volume_hoop_stress = P.volume[p] * P.hoop_stress[p];
-      for (int k = 0; k < Shape::stencil_size; ++k) {
+      for (int k = 0; k < s.count; ++k) {
         NodeSums& node = sums[s.node[k]];
         const double w = s.weight[k];
         if constexpr (with_mass) node.mass += w * m;
@@ -231,7 +231,7 @@ void grid_to_particles(const Shape& shape, const GridFields& g, Particles& P, do
       Vec2 acceleration = Vec2::Zero(), velocity = Vec2::Zero();
       Mat2 L = Mat2::Zero();
       double hoop_rate = 0.0;
-      for (int k = 0; k < Shape::stencil_size; ++k) {
+      for (int k = 0; k < s.count; ++k) {
         const int i = s.node[k];
         if constexpr (with_velocity) acceleration += s.weight[k] * g.acceleration[i];
         if constexpr (with_position) velocity += s.weight[k] * g.velocity[i];
@@ -335,7 +335,7 @@ void smooth_node_dilatation(const Shape& shape, Particles& P, std::vector<std::v
 #pragma omp for schedule(static)
     for (std::size_t p = 0; p < n; ++p) {
       shape.evaluate(p, s);
-      for (int k = 0; k < Shape::stencil_size; ++k) {
+      for (int k = 0; k < s.count; ++k) {
         own[2 * std::size_t(s.node[k])] += s.weight[k] * P.reference_volume[p];
         own[2 * std::size_t(s.node[k]) + 1] += s.weight[k] * P.volume[p];
       }
@@ -348,7 +348,7 @@ void smooth_node_dilatation(const Shape& shape, Particles& P, std::vector<std::v
     for (std::size_t p = 0; p < n; ++p) {
       shape.evaluate(p, s);
       double J_bar = 0.0, weight = 0.0;
-      for (int k = 0; k < Shape::stencil_size; ++k) {
+      for (int k = 0; k < s.count; ++k) {
         const std::size_t i = std::size_t(s.node[k]);
         if (!(sums[2 * i] > 0.0)) continue;
         J_bar += s.weight[k] * sums[2 * i + 1] / sums[2 * i];

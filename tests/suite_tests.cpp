@@ -177,6 +177,38 @@ TEST(SuiteRunner, ResumeRunsOnlyWhatIsMissing) {
   EXPECT_EQ(count(read(dir / "out" / "manifest.json"), "kept from an earlier run"), 2);
 }
 
+// Results written before a key existed are kept when that key is at its
+// default now (the behaviour the key was added with) and rerun otherwise; a
+// stored key with another value, or one the scene no longer has, is a change.
+TEST(SuiteRunner, ResultsOlderThanAKeyAreKeptOnlyAtItsDefault) {
+  const fs::path dir = scratch("older");
+  const mpmvv::app::Suite s = mpmvv::app::load_suite(write(dir / "s.toml", small_suite()).string());
+  const mpmvv::app::SuiteCase& c = s.cases.front();
+  auto without = [](const std::string& text, const std::string& key) {
+    const auto at = text.find("\n" + key + " = ");
+    EXPECT_NE(at, std::string::npos) << key;
+    return text.substr(0, at + 1) + text.substr(text.find('\n', at + 1) + 1);
+  };
+  auto with = [](const std::string& text, const std::string& key, const std::string& value) {
+    const auto at = text.find("\n" + key + " = ") + 1;
+    const auto end = text.find('\n', at);
+    return text.substr(0, at) + key + " = " + value + text.substr(end);
+  };
+  std::vector<std::string> added;
+  EXPECT_TRUE(mpmvv::app::same_configuration(c.configuration, c.configuration, c.defaults, &added));
+  EXPECT_TRUE(added.empty());
+  // probe_points and dilatation are at their defaults in this case; cells and end_time are not.
+  ASSERT_EQ(c.keys.at("probe_points"), "51");
+  const std::string older = without(without(c.configuration, "probe_points"), "dilatation");
+  EXPECT_TRUE(mpmvv::app::same_configuration(older, c.configuration, c.defaults, &added));
+  EXPECT_EQ(added, (std::vector<std::string>{"dilatation", "probe_points"}));
+  EXPECT_FALSE(mpmvv::app::same_configuration(without(c.configuration, "cells"), c.configuration, c.defaults));
+  EXPECT_FALSE(mpmvv::app::same_configuration(without(c.configuration, "end_time"), c.configuration, c.defaults));
+  EXPECT_FALSE(mpmvv::app::same_configuration(older, with(c.configuration, "probe_points", "11"), c.defaults));
+  EXPECT_FALSE(mpmvv::app::same_configuration(with(c.configuration, "cfl", "0.25"), c.configuration, c.defaults));
+  EXPECT_FALSE(mpmvv::app::same_configuration(c.configuration + "retired_key = 1\n", c.configuration, c.defaults));
+}
+
 #ifdef MPMVV_HAVE_MPI
 // Under mpirun the two ranks share the cases and one manifest lists them all.
 TEST(SuiteRunner, MpiRanksShareTheCases) {

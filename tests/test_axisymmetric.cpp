@@ -110,7 +110,7 @@ Sums stencil_sums(const GridGeometry& grid, const Shape& shape, std::size_t p) {
   Stencil<Shape::stencil_size> s;
   shape.evaluate(p, s);
   Sums sums;
-  for (int k = 0; k < Shape::stencil_size; ++k) {
+  for (int k = 0; k < s.count; ++k) {
     const Vec2 x = node_position(grid, s.node[k]);
     sums.weight += s.weight[k];
     sums.gradient += s.gradient[k];
@@ -371,7 +371,7 @@ std::map<int, NodeFactors> factors_by_node(const Shape& shape, std::size_t p) {
   Stencil<Shape::stencil_size> st;
   shape.evaluate(p, st);
   std::map<int, NodeFactors> out;
-  for (int k = 0; k < st.size; ++k) {
+  for (int k = 0; k < st.count; ++k) {
     NodeFactors& f = out[st.node[k]];
     f.weight += st.weight[k];
     f.gradient += st.gradient[k];
@@ -526,7 +526,7 @@ TEST(AxisymmetricShape, CpdiExactDomainOverTheAxisKeepsItsPartAtPositiveRadius) 
     Stencil<CpdiExactShapeT<kRz>::stencil_size> st;
     shape.evaluate(p, st);
     const Sums sums = stencil_sums(grid, shape, p);
-    for (int k = 0; k < st.size; ++k) EXPECT_GE(st.weight[k], 0.0);
+    for (int k = 0; k < st.count; ++k) EXPECT_GE(st.weight[k], 0.0);
     EXPECT_NEAR(sums.weight, 1.0, kRoundOff);
     EXPECT_LE(sums.gradient.norm() * grid.h, kRoundOff);
     EXPECT_LE((sums.completeness - Mat2::Identity()).cwiseAbs().maxCoeff(), kRoundOff);
@@ -756,7 +756,7 @@ TEST(Walls, MirroredGhostsExtendAnOddRadialVelocity) {
     Stencil<CpdiShapeT<kRz>::stencil_size> s;
     shape.evaluate(p, s);
     double hoop_rate = 0.0;
-    for (int k = 0; k < s.size; ++k) hoop_rate += s.hoop[k] * g.velocity[std::size_t(s.node[k])].x();
+    for (int k = 0; k < s.count; ++k) hoop_rate += s.hoop[k] * g.velocity[std::size_t(s.node[k])].x();
     worst = std::max(worst, std::abs(hoop_rate - c) / c);
     EXPECT_NEAR(hoop_rate, c, 1e-14) << P.position[p].transpose();
   }

@@ -56,7 +56,7 @@ struct NodeValues {
 template <int N>
 std::map<int, NodeValues> by_node(const Stencil<N>& s) {
   std::map<int, NodeValues> out;
-  for (int k = 0; k < N; ++k) {
+  for (int k = 0; k < s.count; ++k) {
     if (s.weight[k] == 0.0 && s.gradient[k].isZero(0.0)) continue;
     out[s.node[k]].weight += s.weight[k];
     out[s.node[k]].gradient += s.gradient[k];

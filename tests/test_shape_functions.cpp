@@ -7,7 +7,9 @@
 
 #include "support.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <map>
 #include <cstddef>
 #include <random>
 #include <string>
@@ -127,7 +129,7 @@ template <int N>
 StencilSums sums_of(const GridGeometry& grid, const Stencil<N>& s) {
   StencilSums out;
   out.smallest_weight = s.weight[0];
-  for (int k = 0; k < N; ++k) {
+  for (int k = 0; k < s.count; ++k) {
     if (s.node[k] < 0 || std::size_t(s.node[k]) >= grid.node_count()) {
       out.nodes_exist = false;
       continue;
@@ -302,6 +304,74 @@ TEST(CpdiShape, DomainVectorsFollowTheDeformationGradient) {
     // The shoelace sum cancels coordinates of order 2 m down to areas of
     // order 1e-3 m^2: a relative 1e-10 covers that cancellation.
     EXPECT_NEAR(area, mpmvv::determinant(F[p]) * 4.0 * l.x() * l.y(), 1e-10 * area);
+  }
+}
+
+// A domain within 2 x 2 cells lists each node it reaches once: 4 entries
+// inside a cell, 6 across one grid line, 9 across two; a domain stretched
+// further keeps four entries per corner. Either way each node carries the
+// definition's S_gp = (1/4) sum_c N_g(x_c) and G_gp = (1/4) s^-T sum_c
+// (xi_c, eta_c) N_g(x_c) (eq. 1.100 in 2D), with N_g the bilinear tent.
+TEST(CpdiShape, ListsEachNodeOnceWithTheDefinitionsValues) {
+  const GridGeometry grid = small_grid();
+  const Mat2 stretch = (Mat2() << 5.0, 0.3, 0.0, 1.0).finished();
+  struct Case {
+    Vec2 xi;  // centre, in cells
+    Mat2 F;
+    int count;
+  };
+  const Case cases[] = {{{3.5, 4.5}, Mat2::Identity(), 4},
+                        {{3.1, 4.5}, Mat2::Identity(), 6},
+                        {{3.5, 3.9}, Mat2::Identity(), 6},
+                        {{3.1, 4.1}, Mat2::Identity(), 9},
+                        {{3.9, 4.1}, mpmvv::testing::simple_shear(0.6), 9},
+                        {{4.0, 4.3}, stretch, 16}};
+  for (const Case& c : cases) {
+    const Particles P = particles_at(grid, {grid.origin + grid.h * c.xi}, {c.F});
+    const CpdiShape shape = CpdiShape::bind(grid, P);
+    ASSERT_TRUE(shape.inside(0));
+    Stencil<CpdiShape::stencil_size> st;
+    shape.evaluate(0, st);
+    SCOPED_TRACE("centre at xi = (" + std::to_string(c.xi.x()) + ", " + std::to_string(c.xi.y()) + ")");
+    EXPECT_EQ(st.count, c.count);
+    struct Values {
+      double weight = 0.0;
+      Vec2 gradient = Vec2::Zero();
+    };
+    std::map<int, Values> got;
+    for (int k = 0; k < st.count; ++k) {
+      if (c.count < 16) {
+        EXPECT_EQ(got.count(st.node[k]), 0u) << "node " << st.node[k] << " listed twice";
+      }
+      got[st.node[k]].weight += st.weight[k];
+      got[st.node[k]].gradient += st.gradient[k];
+    }
+    // The definition, node by node.
+    const Mat2 s = shape.domain(0);
+    const Mat2 s_inv_t = mpmvv::inverse(s).transpose();
+    std::map<int, Values> expected;
+    const double corner_xi[4] = {-1, 1, 1, -1}, corner_eta[4] = {-1, -1, 1, 1};
+    for (int k = 0; k < 4; ++k) {
+      const Vec2 x = (P.position[0] + corner_xi[k] * s.col(0) + corner_eta[k] * s.col(1) - grid.origin) / grid.h;
+      for (int j = 0; j <= grid.cells_y; ++j)
+        for (int i = 0; i <= grid.cells_x; ++i) {
+          const double N = std::max(0.0, 1.0 - std::abs(x.x() - i)) * std::max(0.0, 1.0 - std::abs(x.y() - j));
+          if (N == 0.0) continue;
+          auto& e = expected[grid.node(i, j)];
+          e.weight += 0.25 * N;
+          e.gradient += 0.25 * N * (s_inv_t * Vec2(corner_xi[k], corner_eta[k]));
+        }
+    }
+    for (const auto& [node, e] : expected) {
+      ASSERT_EQ(got.count(node), 1u) << "node " << node << " missing";
+      EXPECT_NEAR(got[node].weight, e.weight, 1e-15) << "node " << node;
+      EXPECT_LT((got[node].gradient - e.gradient).norm() * grid.h, 1e-14) << "node " << node;
+    }
+    for (const auto& [node, g] : got) {
+      if (!expected.count(node)) {
+        EXPECT_LT(std::abs(g.weight) + g.gradient.norm() * grid.h, 1e-15) << "node " << node;
+      }
+    }
   }
 }
 

@@ -231,7 +231,7 @@ class StaticStepper final : public Stepper {
   // dF = I + sum_g u_g (x) G_gp over a particle's stencil.
   static Mat2 increment(const Stencil<Shape::stencil_size>& s, const std::vector<Vec2>& u) {
     Mat2 dF = Mat2::Identity();
-    for (int k = 0; k < Shape::stencil_size; ++k) dF += u[std::size_t(s.node[k])] * s.gradient[k].transpose();
+    for (int k = 0; k < s.count; ++k) dF += u[std::size_t(s.node[k])] * s.gradient[k].transpose();
     return dF;
   }
 
@@ -284,7 +284,7 @@ class StaticStepper final : public Stepper {
       shape.evaluate(p, s);
       // Merge the stencil's repeated nodes (CPDI's corners share nodes).
       int distinct = 0;
-      for (int k = 0; k < Shape::stencil_size; ++k) {
+      for (int k = 0; k < s.count; ++k) {
         if (s.weight[k] == 0.0 && s.gradient[k].isZero()) continue;
         int at = 0;
         while (at < distinct && node[at] != s.node[k]) ++at;
@@ -413,7 +413,7 @@ class StaticStepper final : public Stepper {
       for (std::size_t p = 0; p < P.size(); ++p) {
         shape.evaluate(p, s);
         Vec2 move = Vec2::Zero();
-        for (int k = 0; k < Shape::stencil_size; ++k) move += s.weight[k] * u_[std::size_t(s.node[k])];
+        for (int k = 0; k < s.count; ++k) move += s.weight[k] * u_[std::size_t(s.node[k])];
         const Vec2 before = previous_body_force_.empty() ? Vec2::Zero() : previous_body_force_[p];
         work += P.mass[p] * 0.5 * (before + P.body_force[p]).dot(move);
       }
@@ -449,7 +449,7 @@ class StaticStepper final : public Stepper {
         shape.evaluate(p, s);
         const Mat2 dF = increment(s, u_);
         Vec2 move = Vec2::Zero();
-        for (int k = 0; k < Shape::stencil_size; ++k) move += s.weight[k] * u_[std::size_t(s.node[k])];
+        for (int k = 0; k < s.count; ++k) move += s.weight[k] * u_[std::size_t(s.node[k])];
         P.deformation_gradient[p] = dF * deformation_n_[p];
         P.volume[p] = determinant(P.deformation_gradient[p]) * P.reference_volume[p];
         P.stress[p] = material_.cauchy_stress(P.deformation_gradient[p]);

@@ -15,6 +15,7 @@
 //   <S/r> = (1 / (4 r_p)) sum_c S_g(x_c).
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 
 #include "../particles.hpp"
@@ -25,7 +26,7 @@ namespace mpmvv {
 
 template <Geometry G>
 struct CpdiShapeT {
-  static constexpr int stencil_size = 16;  // four nodes for each of four corners
+  static constexpr int stencil_size = 16;  // four nodes for each of four corners, at most
   static constexpr const char* name = "cpdi";
   static constexpr Geometry geometry = G;
   static constexpr bool reads_deformation_gradient = true;
@@ -62,7 +63,14 @@ struct CpdiShapeT {
     return position[p] + corner_xi[c] * s.col(0) + corner_eta[c] * s.col(1);
   }
 
+  // The corners' shares of the node values: corner c passes S_g(x_c) to each
+  // of the four nodes of its cell with the factors of S_gp, G_gp and <S/r>
+  // above. A domain within 2 x 2 cells (every domain up to a cell across,
+  // which is all of them until shear stretches one) reaches at most the 3 x 3
+  // nodes from its lowest corner cell: each is summed and listed once (4, 6 or
+  // 9 entries instead of 16), which the transfers then visit once.
   void evaluate(std::size_t p, Stencil<stencil_size>& st) const {
+    const GridGeometry& g = *grid;
     const Mat2 s = domain(p);
     // s^-T = [[s11, -s10], [-s01, s00]] / det s.
     const double inv_det = gradient_scale / determinant(s);
@@ -72,24 +80,80 @@ struct CpdiShapeT {
       weight_a = s(0, 0) * weight_r;
       weight_b = s(0, 1) * weight_r;
     }
+    const double hoop_factor = 0.75 * weight_r;  // <S/r> = (1 / (4 r_p)) sum_c S_g(x_c)
+    int cell_i[4], cell_j[4];
+    double fx[4], fy[4], corner_weight[4];
+    Vec2 corner_gradient[4];
     for (int c = 0; c < 4; ++c) {
       const double xi = corner_xi[c], eta = corner_eta[c];
-      double corner_weight = 0.25, gxi = 0.25 * xi, geta = 0.25 * eta;
+      double cw = 0.25, gxi = 0.25 * xi, geta = 0.25 * eta;
       if constexpr (G == Geometry::axisymmetric) {
-        corner_weight *= 1.0 + weight_a * xi + weight_b * eta;
+        cw *= 1.0 + weight_a * xi + weight_b * eta;
         gxi *= 1.0 + weight_b * eta;
         geta *= 1.0 + weight_a * xi;
       }
-      const Vec2 corner_gradient = inv_det * Vec2(s(1, 1) * gxi - s(1, 0) * geta, s(0, 0) * geta - s(0, 1) * gxi);
-      int* node = st.node + 4 * c;
-      double* w = st.weight + 4 * c;
-      bilinear_cell_weights(*grid, corner(p, s, c), node, w);
+      corner_weight[c] = cw;
+      corner_gradient[c] = inv_det * Vec2(s(1, 1) * gxi - s(1, 0) * geta, s(0, 0) * geta - s(0, 1) * gxi);
+      const Vec2 x = grid_coordinate(g, corner(p, s, c));
+      cell_i[c] = cell_index(x.x(), g.cells_x);
+      cell_j[c] = cell_index(x.y(), g.cells_y);
+      fx[c] = x.x() - cell_i[c];
+      fy[c] = x.y() - cell_j[c];
+    }
+    const int i0 = std::min(std::min(cell_i[0], cell_i[1]), std::min(cell_i[2], cell_i[3]));
+    const int j0 = std::min(std::min(cell_j[0], cell_j[1]), std::min(cell_j[2], cell_j[3]));
+    const int span_i = std::max(std::max(cell_i[0], cell_i[1]), std::max(cell_i[2], cell_i[3])) - i0;
+    const int span_j = std::max(std::max(cell_j[0], cell_j[1]), std::max(cell_j[2], cell_j[3])) - j0;
+    // S_g(x_c) of the four nodes of corner c's cell, in node order (i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1).
+    auto bilinear = [&](int c, double* b) {
+      const double gx = 1.0 - fx[c], gy = 1.0 - fy[c];
+      b[0] = gx * gy;
+      b[1] = fx[c] * gy;
+      b[2] = gx * fy[c];
+      b[3] = fx[c] * fy[c];
+    };
+    if (span_i > 1 || span_j > 1) {
+      // A domain stretched beyond 2 x 2 cells: four entries per corner.
+      for (int c = 0; c < 4; ++c) {
+        double b[4];
+        bilinear(c, b);
+        const int n00 = g.node(cell_i[c], cell_j[c]);
+        const int nodes[4] = {n00, n00 + 1, n00 + g.nodes_x(), n00 + g.nodes_x() + 1};
+        for (int k = 0; k < 4; ++k) {
+          st.node[4 * c + k] = nodes[k];
+          st.weight[4 * c + k] = corner_weight[c] * b[k];
+          st.gradient[4 * c + k] = corner_gradient[c] * b[k];
+          if constexpr (G == Geometry::axisymmetric) st.hoop[4 * c + k] = hoop_factor * b[k];
+        }
+      }
+      st.count = stencil_size;
+      return;
+    }
+    // Node (i0 + a, j0 + b) sums into slot a + 3 b.
+    double w[9] = {}, hoop[9] = {};
+    Vec2 grad[9];
+    for (Vec2& v : grad) v.setZero();
+    for (int c = 0; c < 4; ++c) {
+      double b[4];
+      bilinear(c, b);
+      const int first = (cell_i[c] - i0) + 3 * (cell_j[c] - j0);
+      const int slot[4] = {first, first + 1, first + 3, first + 4};
       for (int k = 0; k < 4; ++k) {
-        st.gradient[4 * c + k] = corner_gradient * w[k];
-        if constexpr (G == Geometry::axisymmetric) st.hoop[4 * c + k] = 0.75 * weight_r * w[k];
-        w[k] *= corner_weight;
+        w[slot[k]] += corner_weight[c] * b[k];
+        grad[slot[k]] += corner_gradient[c] * b[k];
+        if constexpr (G == Geometry::axisymmetric) hoop[slot[k]] += hoop_factor * b[k];
       }
     }
+    int n = 0;
+    for (int b = 0; b <= span_j + 1; ++b)
+      for (int a = 0; a <= span_i + 1; ++a, ++n) {
+        const int slot = a + 3 * b;
+        st.node[n] = g.node(i0 + a, j0 + b);
+        st.weight[n] = w[slot];
+        st.gradient[n] = grad[slot];
+        if constexpr (G == Geometry::axisymmetric) st.hoop[n] = hoop[slot];
+      }
+    st.count = n;
   }
 
   // The centre lies between the walls (in r-z off the axis) and every corner

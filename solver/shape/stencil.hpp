@@ -17,9 +17,13 @@ namespace mpmvv {
 // the particle, which carries the hoop stress to the radial force and the
 // radial velocity to the hoop rate (the same weight both ways, so the hoop
 // work is conserved). Plane-strain shapes leave it unset.
+//
+// The first `count` entries are in use: N for every shape but CPDI, whose
+// corners often share nodes and which then lists each node once (cpdi.hpp).
 template <int N>
 struct Stencil {
   static constexpr int size = N;
+  int count = N;
   int node[N];
   double weight[N];
   Vec2 gradient[N];

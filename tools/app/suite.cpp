@@ -333,6 +333,7 @@ Suite load_suite(const std::string& path) {
         // The scene's own rules between keys, before anything runs.
         find_scene_type(config.scene())->build(config);
         c.configuration = config.to_toml();
+        c.defaults = Config(config.scene(), specs).to_toml();
         for (const KeySpec& k : specs) c.keys[k.name] = json_value(config.value(k.name));
         for (const SuiteCase& other : suite.cases)
           if (other.id == c.id) throw ConfigError(fmt::format("{}: two cases have the id '{}'", here, c.id));
@@ -470,18 +471,59 @@ std::string last_line(const fs::path& log) {
 
 // What a results file says of its run, or nothing when it is not a
 // finished results file of this configuration.
-std::optional<CaseState> finished_state(const fs::path& results, const std::string& configuration) {
+// "key = value" lines of a resolved configuration, by key.
+std::map<std::string, std::string> configuration_lines(const std::string& text) {
+  std::map<std::string, std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) {
+    const auto eq = line.find(" = ");
+    if (eq != std::string::npos) lines[line.substr(0, eq)] = line.substr(eq + 3);
+  }
+  return lines;
+}
+
+}  // namespace
+
+bool same_configuration(const std::string& stored, const std::string& wanted, const std::string& defaults,
+                        std::vector<std::string>* added) {
+  if (stored == wanted) return true;
+  const auto old_lines = configuration_lines(stored);
+  const auto new_lines = configuration_lines(wanted);
+  const auto default_lines = configuration_lines(defaults);
+  std::vector<std::string> missing;
+  for (const auto& [key, value] : old_lines) {
+    const auto it = new_lines.find(key);
+    if (it == new_lines.end() || it->second != value) return false;
+  }
+  for (const auto& [key, value] : new_lines) {
+    if (old_lines.count(key)) continue;
+    const auto it = default_lines.find(key);
+    if (it == default_lines.end() || it->second != value) return false;
+    missing.push_back(key);
+  }
+  if (added) *added = missing;
+  return true;
+}
+
+namespace {
+
+std::optional<CaseState> finished_state(const fs::path& results, const SuiteCase& c) {
   if (!fs::exists(results)) return std::nullopt;
   try {
     const h5::File f = h5::File::open_read(results.string());
     const h5::Group root = f.root();
-    if (root.attribute_string("configuration") != configuration) return std::nullopt;
+    std::vector<std::string> added;
+    if (!same_configuration(root.attribute_string("configuration"), c.configuration, c.defaults, &added))
+      return std::nullopt;
     CaseState s;
     s.status = root.attribute_string("status");
     s.exit_code = s.status == "completed" ? 0 : 1;
     s.wall = root.attribute_double("wall_time_s");
     if (s.status != "completed")
       s.detail = fmt::format("{} at t = {:.4g} s", root.attribute_string("failure_reason"), root.attribute_double("failure_time"));
+    if (!added.empty())
+      s.detail += fmt::format("{}written before {} existed (at {} now)", s.detail.empty() ? "" : "; ",
+                              fmt::join(added, ", "), added.size() == 1 ? "its default" : "their defaults");
     return s;
   } catch (const std::exception&) {
     return std::nullopt;
@@ -655,7 +697,7 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
   std::size_t resumed = 0;
   for (std::size_t i = 0; i < n; ++i) {
     if (i % std::size_t(ranks) != std::size_t(rank)) continue;
-    if (const auto done = finished_state(results_of(i), suite.cases[i].configuration)) {
+    if (const auto done = finished_state(results_of(i), suite.cases[i])) {
       state[i] = *done;
       state[i].detail = (state[i].detail.empty() ? "" : state[i].detail + "; ") + "kept from an earlier run";
       record(i);
@@ -756,7 +798,7 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
       } else {
         s.exit_code = WEXITSTATUS(status);
         if (s.exit_code == 0 || s.exit_code == 1) {
-          const auto done = finished_state(results_of(i), suite.cases[i].configuration);
+          const auto done = finished_state(results_of(i), suite.cases[i]);
           if (done) {
             s = *done;
             s.wall = wall;

@@ -18,6 +18,7 @@ struct SuiteCase {
   std::string scene_file;              // as the runner passes it to `mpmvv run`
   std::vector<std::string> overrides;  // "key=value"
   std::string configuration;           // the resolved configuration (TOML), to recognise a finished case
+  std::string defaults;                // the scene's defaults in the same form, for results older than a key
   std::map<std::string, std::string> keys;  // every resolved scene key, as JSON values
 };
 
@@ -40,6 +41,15 @@ struct SuiteRequest {
   bool quiet = false;
   bool list = false;         // check the suite and print its cases; run nothing
 };
+
+// Whether a results file written with configuration `stored` is the run that
+// `wanted` asks for now. Every key stored must have the value wanted. A key
+// wanted but absent from `stored` was added to the scene after that file was
+// written; keys are added with defaults that keep the earlier behaviour, so
+// such a key must be at its default (`defaults`, the scene's configuration with
+// nothing set) for the file to count. Those keys are listed in `added`.
+bool same_configuration(const std::string& stored, const std::string& wanted, const std::string& defaults,
+                        std::vector<std::string>* added = nullptr);
 
 // Exit status: 0 every case completed or was stopped by the solver (both are
 // results); 1 a case crashed, timed out or was refused; 2 bad input; 130
