@@ -1,6 +1,9 @@
 // OpenMP helpers. Without OpenMP everything runs on one thread.
 #pragma once
 
+#include <cstddef>
+#include <vector>
+
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -29,6 +32,16 @@ inline void set_threads(int n) {
 #else
   (void)n;
 #endif
+}
+
+// Called by every thread of a parallel region once each thread has filled its
+// own buffer (after the barrier of the loop that filled them): adds the first
+// `count` entries of every buffer into the first buffer, the entries shared
+// out over the threads.
+inline void sum_into_first(std::vector<std::vector<double>>& per_thread, std::size_t count) {
+#pragma omp for schedule(static)
+  for (std::size_t i = 0; i < count; ++i)
+    for (std::size_t t = 1; t < per_thread.size(); ++t) per_thread[0][i] += per_thread[t][i];
 }
 
 }  // namespace mpmvv

@@ -301,9 +301,7 @@ void average_cell_dilatation(const GridGeometry& grid, Particles& P, std::vector
       own[2 * c] += P.reference_volume[p];
       own[2 * c + 1] += P.volume[p];
     }
-#pragma omp for schedule(static)
-    for (std::size_t c = 0; c < 2 * cells; ++c)
-      for (int t = 1; t < threads; ++t) cell_volume[0][c] += cell_volume[std::size_t(t)][c];
+    sum_into_first(cell_volume, 2 * cells);
 #pragma omp for schedule(static)
     for (std::size_t p = 0; p < n; ++p) {
       const std::size_t c = cell_of(p);
@@ -340,9 +338,7 @@ void smooth_node_dilatation(const Shape& shape, Particles& P, std::vector<std::v
         own[2 * std::size_t(s.node[k]) + 1] += s.weight[k] * P.volume[p];
       }
     }
-#pragma omp for schedule(static)
-    for (std::size_t i = 0; i < 2 * nodes; ++i)
-      for (int t = 1; t < threads; ++t) node_volume[0][i] += node_volume[std::size_t(t)][i];
+    sum_into_first(node_volume, 2 * nodes);
     const std::vector<double>& sums = node_volume[0];
 #pragma omp for schedule(static)
     for (std::size_t p = 0; p < n; ++p) {
