@@ -18,6 +18,7 @@
 #include <fmt/ostream.h>
 
 #include "config.hpp"
+#include "mpmvv_commit.hpp"
 #include "fault.hpp"
 #include "scene.hpp"
 #include "solver/parallel.hpp"
