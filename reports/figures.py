@@ -19,7 +19,7 @@ returns a matplotlib Figure (Agg backend; no display needed):
   level, against an exact curve drawn as a line (the Hertz contact pressure);
 * histories: one line per case of a scalar against another recorded after
   every step (the Hertz load against approach);
-* run_health: four panels over time from /probes/monitors, one line per case:
+* run_health: four panels (five with the measured stable step) over time from /probes/monitors, one line per case:
   the energy balance error over its scale, J's range, the largest speed over
   the wave speed and the largest CPDI domain distortion; a failed case's
   failure time marked x.
@@ -335,6 +335,9 @@ class HealthCurve:
     distortion: np.ndarray        # max_domain_distortion; NaN for linear MPM
     style: Style = field(default_factory=Style)
     stopped_at: float = float("nan")   # failure time of a failed case (marked x); NaN for a completed one
+    # cfl_step / stable_step: the step the CFL rule takes over the measured stable step 2 / omega_max
+    # (stable_step_iterations > 0); None, or NaN at every time, where not measured
+    step_ratio: np.ndarray = None
 
 
 LINE_STYLES = ["-", "--", "-.", ":"]
@@ -345,10 +348,16 @@ def run_health(curves, title):
     its style; the line style changes after every len(COLOURS) curves so that no two
     look alike): the energy balance error (log), min J and max J with J = 0 dotted,
     the largest speed over wave speed, the largest domain distortion (log; a note
-    instead when every value is NaN, as for linear MPM). A curve with a finite
+    instead when every value is NaN, as for linear MPM); and a fifth when any curve
+    has a finite step_ratio: the step over the measured stable step, dotted at 1,
+    above which the linearized step is unstable. A curve with a finite
     `stopped_at` gets an x there, at the height of its last drawn value."""
-    figure, axes = plt.subplots(4, 1, figsize=(10.5, 11.0), sharex=True, squeeze=False, constrained_layout=True)
-    energy, jacobian, speed, distortion = axes[:, 0]
+    with_ratio = any(c.step_ratio is not None and np.isfinite(np.asarray(c.step_ratio, float)).any() for c in curves)
+    rows = 5 if with_ratio else 4
+    figure, axes = plt.subplots(rows, 1, figsize=(10.5, 2.75 * rows), sharex=True, squeeze=False,
+                                constrained_layout=True)
+    energy, jacobian, speed, distortion = axes[:4, 0]
+    ratio = axes[4, 0] if with_ratio else None
     drawn = {energy: False, distortion: False}
     for k, curve in enumerate(curves):
         line = dict(color=curve.style.colour, marker=curve.style.marker, markersize=4, linewidth=1.2,
@@ -367,6 +376,9 @@ def run_health(curves, title):
         # every curve has a line here (NaN values draw nothing): the legend is taken from it
         speed.plot(t, curve.speed_ratio, label=curve.label, **line)
         _mark_stop(speed, curve, t, curve.speed_ratio)
+        if ratio is not None and curve.step_ratio is not None:
+            ratio.plot(t, curve.step_ratio, **line)
+            _mark_stop(ratio, curve, t, curve.step_ratio)
     jacobian.axhline(0.0, color="black", linestyle=":", linewidth=1.0)
     jacobian.annotate("J = 0", (0.0, 0.0), xycoords=("axes fraction", "data"), xytext=(3, 3),
                       textcoords="offset points", fontsize=8)
@@ -381,7 +393,13 @@ def run_health(curves, title):
     _label_panel(energy, "", "|energy created| / scale", "energy balance error")
     _label_panel(jacobian, "", "J = det F", "min J and max J over the particles")
     _label_panel(speed, "", "max |v| / c", "largest particle speed over its wave speed")
-    _label_panel(distortion, "time t [s]", "max domain distortion", "largest domain distortion (1: square)")
+    _label_panel(distortion, "" if ratio is not None else "time t [s]", "max domain distortion",
+                 "largest domain distortion (1: square)")
+    if ratio is not None:
+        ratio.axhline(1.0, color="black", linestyle=":", linewidth=1.0)
+        ratio.set_ylim(bottom=0.0)
+        _label_panel(ratio, "time t [s]", "dt / (2 / omega_max)",
+                     "the CFL step over the measured stable step (unstable above 1)")
     handles, labels = speed.get_legend_handles_labels()
     if any(math.isfinite(c.stopped_at) for c in curves):
         handles.append(matplotlib.lines.Line2D([], [], color="black", marker="x", linestyle="none", markersize=8,

@@ -616,7 +616,8 @@ def health_figure(study, all_series, directory):
         curves.append(figures.HealthCurve(label, monitors.time, relative_energy_created(monitors),
                                           monitors.column("min_J"), monitors.column("max_J"),
                                           monitors.column("max_speed_over_wave_speed"),
-                                          monitors.column("max_domain_distortion"), style, stop))
+                                          monitors.column("max_domain_distortion"), style, stop,
+                                          monitors.column("cfl_step") / monitors.column("stable_step")))
     figure = figures.run_health(curves, f"{study}: run health at the output times")
     path = directory / f"{slug(study, 'health')}.png"
     figures.save_png(figure, path)
@@ -625,7 +626,9 @@ def health_figure(study, all_series, directory):
                "abs(work) any one work_* term has done so far, the scale of the blow-up test (log scale); "
                "min J and max J over the particles (the lower and upper line of a case's colour), dotted at J = 0; "
                "the largest particle speed over its wave speed; the largest CPDI domain distortion (1: a square "
-               "domain; log scale; none for linear MPM). x: the failure time of a failed case, at the height of its "
+               "domain; log scale; none for linear MPM); where the runs measured it (stable_step_iterations), the "
+               "step the CFL rule takes over the measured stable step 2 / omega_max of the linearized grid motion, "
+               "unstable above 1 (dotted). x: the failure time of a failed case, at the height of its "
                "last recorded value (dotted from its last output).")
     if selected:
         caption += (f" {len(chosen)} of the {len(found)} cases with monitors are drawn: those that failed and the "

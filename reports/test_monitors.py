@@ -171,3 +171,28 @@ def test_many_cases_draw_the_failed_and_the_finest_completed_of_each_method():
     assert selected and [c.id for c in chosen] == ["linear-256", "linear-512", "cpdi-512"]
     few, selected = report.health_selection(cases[:report.HEALTH_MAX_CASES])
     assert not selected and len(few) == report.HEALTH_MAX_CASES
+
+
+@needs_gold
+def test_measured_stable_step_adds_the_step_ratio(tmp_path, drawn):
+    """Requirement: where the runs measured their stable step (the monitors
+    largest_frequency, stable_step and cfl_step of stable_step_iterations), each
+    curve carries cfl_step / stable_step, the figure gets its fifth panel and the
+    caption says what it is; without those columns the curves carry NaN there."""
+    directory = gold_with_results(tmp_path / "suite", monitors_in=("ring", "rz-cylinder"))
+    for path in (directory / "cases").glob("ring-method=*.h5"):
+        with h5py.File(path, "a") as f:
+            group = f["probes/monitors"]
+            t = group["time"][:]
+            group["largest_frequency"] = 100.0 * (1.0 + t)
+            group["stable_step"] = 2.0 / (100.0 * (1.0 + t))
+            group["cfl_step"] = 0.004 + 0.0 * t
+    written, _ = report.write_report(directory, tmp_path / "out")
+    ring = drawn["ring: run health at the output times"]
+    assert ring and all(np.allclose(c.step_ratio, 0.004 * 100.0 * (1.0 + c.time) / 2.0) for c in ring)
+    assert all(np.isnan(c.step_ratio).all() for c in drawn["rz-cylinder: run health at the output times"])
+    assert "the step the CFL rule takes over the measured stable step" in written["markdown"].read_text()
+    figure = figures.run_health(ring, "five panels")
+    assert len(figure.axes) == 5
+    four = figures.run_health(drawn["rz-cylinder: run health at the output times"], "four panels")
+    assert len(four.axes) == 4

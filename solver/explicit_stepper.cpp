@@ -1,6 +1,7 @@
 #include "explicit_stepper.hpp"
 
 #include <chrono>
+#include <cstdint>
 #include <cmath>
 #include <stdexcept>
 
@@ -96,13 +97,81 @@ class ExplicitStepper final : public Stepper {
   // last step, and central differences are stable to dt = (2 / omega)
   // (sqrt(1 + xi^2) - xi): the signal speed grows by sqrt(1 + xi^2) + xi.
   ParticleScan scan() const override {
-    ParticleScan s = scan_particles(bind(model_.particles), material_, model_.particles);
+    ParticleScan s = scan_particles(bind(model_.particles), material_, model_.particles, model_.grid.h);
     if (viscous()) s.max_signal_speed *= std::sqrt(1.0 + viscous_ratio_ * viscous_ratio_) + viscous_ratio_;
     return s;
   }
 
   Monitors monitors() const override {
     return monitor_particles(bind(model_.particles), material_, model_.particles, model_.grid);
+  }
+
+  // Power iteration on A u = M^-1 K u over grid displacements u, where K u is
+  // the internal force the grid displacement u takes away, found as the
+  // difference f(state) - f(state moved by u) with u a millionth of a cell:
+  // every particle moved and deformed by u as a step moves them (positions,
+  // F, CPDI domains, stress; eqs. 1.73-1.76), so the operator is the step's
+  // own linearization. The Rayleigh quotient u.Ku / u.Mu (M the lumped node
+  // masses) after the last iteration estimates omega_max^2 from below.
+  double largest_frequency(int iterations) const override {
+    const Particles& P = model_.particles;
+    const GridGeometry& grid = model_.grid;
+    const std::size_t nodes = grid.node_count();
+    ScatterBuffers buffers;
+    buffers.resize(max_threads(), nodes);
+    GridFields base;
+    base.resize(nodes);
+    particles_to_grid<kMass | kInternalForce>(bind(P), P, buffers, base);
+    // A fixed start with every node and both axes in it: the result repeats.
+    std::vector<Vec2> u(nodes, Vec2::Zero());
+    std::uint64_t state = 0x9E3779B97F4A7C15ull;
+    auto next = [&state] {
+      state ^= state << 13;
+      state ^= state >> 7;
+      state ^= state << 17;
+      return double(state >> 11) * 0x1.0p-53 - 0.5;
+    };
+    for (std::size_t i = 0; i < nodes; ++i)
+      if (base.mass[i] > 0.0) u[i] = Vec2(next(), next());
+    Particles moved = P;
+    GridFields perturbed;
+    perturbed.resize(nodes);
+    double lambda = 0.0;
+    for (int it = 0; it < iterations; ++it) {
+      double largest = 0.0;
+      for (const Vec2& v : u) largest = std::max(largest, v.cwiseAbs().maxCoeff());
+      if (!(largest > 0.0)) return 0.0;
+      const double eps = 1e-6 * grid.h / largest;
+      for (std::size_t i = 0; i < nodes; ++i) {
+        perturbed.velocity[i] = eps * u[i];
+        perturbed.acceleration[i].setZero();
+      }
+      apply_walls(grid, perturbed);
+      for (std::size_t i = 0; i < nodes; ++i) u[i] = perturbed.velocity[i] / eps;
+      moved.position = P.position;
+      moved.deformation_gradient = P.deformation_gradient;
+      if constexpr (Shape::geometry == Geometry::axisymmetric) moved.hoop_stretch = P.hoop_stretch;
+      grid_to_particles<kPosition | kDeformation, Shape>(bind(P), perturbed, moved, 1.0, 0.0);
+      update_stress<Shape::geometry>(material_, moved);
+      particles_to_grid<kInternalForce>(bind(moved), moved, buffers, perturbed);
+      double uKu = 0.0, uMu = 0.0;
+      for (std::size_t i = 0; i < nodes; ++i) {
+        if (!(base.mass[i] > 0.0)) {
+          u[i].setZero();
+          continue;
+        }
+        const Vec2 Ku = (base.force[i] - perturbed.force[i]) / eps;
+        uKu += u[i].dot(Ku);
+        uMu += base.mass[i] * u[i].squaredNorm();
+        u[i] = Ku / base.mass[i];
+      }
+      lambda = uKu / uMu;
+      double size = 0.0;  // keep u of order one: lambda^iterations overflows
+      for (const Vec2& v : u) size = std::max(size, v.cwiseAbs().maxCoeff());
+      if (size > 0.0)
+        for (Vec2& v : u) v /= size;
+    }
+    return std::sqrt(std::max(lambda, 0.0));
   }
 
   ParticleFault diagnose(std::size_t p) const override {

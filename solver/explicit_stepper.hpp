@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <limits>
 #include <memory>
 #include <string>
 #include <utility>
@@ -51,6 +52,10 @@ class Stepper {
   virtual std::vector<std::pair<std::string, double>> statistics() const { return {}; }
   // The run's health now (monitors.hpp), and the work done on it so far.
   virtual Monitors monitors() const = 0;
+  // The largest frequency omega_max [rad/s] of the grid's motion linearized
+  // about the current state, by power iteration (explicit steppers; NaN
+  // otherwise). Central differences are stable while dt <= 2 / omega_max.
+  virtual double largest_frequency(int /*iterations*/) const { return std::numeric_limits<double>::quiet_NaN(); }
   const EnergyLedger& ledger() const { return ledger_; }
 
  protected:

@@ -463,7 +463,7 @@ inline void advect_tracers(const GridGeometry& grid, const GridFields& g, std::v
 // ---------------------------------------------------------------- health and time step
 
 struct ParticleScan {
-  double max_signal_speed = 0.0;  // max_p (c_p + |v_p|)
+  double max_signal_speed = 0.0;  // max_p (max(c_p, k_p c0_p) + |v_p|): scan_particles
   std::size_t first_unhealthy;    // lowest index of a particle that stops the run, or size()
 };
 
@@ -484,11 +484,62 @@ bool particle_healthy(const Shape& shape, const Particles& P, std::size_t p) {
   return finite && J > 0.0 && shape.inside(p);
 }
 
-// One pass over particles: the largest signal speed c_p + |v_p|, with c_p the
-// material's wave speed bound at the particle's current state and density
-// rho_p = m_p / V_p, and the first particle whose state stops the run.
+// The sum over nodes of |G_gp| for particle p's stencil, each node counted
+// once (a stretched CPDI domain lists a node once per corner that reaches it).
+template <class Shape>
+double gradient_sum(const Shape& shape, std::size_t p) {
+  Stencil<Shape::stencil_size> s;
+  shape.evaluate(p, s);
+  double sum = 0.0;
+  for (int k = 0; k < s.count; ++k) {
+    bool first = true;
+    for (int j = 0; j < k && first; ++j) first = s.node[j] != s.node[k];
+    if (!first) continue;
+    Vec2 g = s.gradient[k];
+    for (int j = k + 1; j < s.count; ++j)
+      if (s.node[j] == s.node[k]) g += s.gradient[j];
+    sum += g.norm();
+  }
+  return sum;
+}
+
+// How many times higher particle p lifts the grid's frequencies than the
+// grid's own basis can: 1, or h sum_g |G_gp| / (2 + sqrt 2) where that is
+// larger. The bilinear basis's gradients sum over the four nodes of a point
+// to at most (2 + sqrt 2) / h (at a node: sqrt 2 + 1 + 1 + 0), and the step
+// cfl h / (c + |v|) is set for them; any average of them over a domain (GIMP,
+// exact CPDI) stays within that. CPDI interpolates the basis bilinearly
+// between its domain's corners (002_c3305cb8b1bc1490.txt eq. 1.95); where a
+// sheared domain's corners straddle cell lines the interpolant is not the
+// basis, and its gradient, s_p^-T times differences of S_g between corners,
+// grows as 1 / sin of the angle between r_1 and r_2. A particle's stiffness
+// grows with the square of its gradients while its mass stays, so the
+// frequencies it takes part in grow with them.
+template <class Shape>
+double stiffening(const Shape& shape, std::size_t p, double h) {
+  if constexpr (Shape::gradients_beyond_grid_basis) {
+    constexpr double grid_basis_bound = 2.0 + 1.4142135623730951;
+    return std::max(1.0, h * gradient_sum(shape, p) / grid_basis_bound);
+  } else {
+    return 1.0;
+  }
+}
+
+// One pass over particles: the largest signal speed max(c_p, k_p c0_p) + |v_p|
+// (c_p + |v_p| where k_p = 1) and the first particle whose state stops the run. c_p is the material's
+// wave speed bound at the particle's current state (it grows with the stress
+// along a stretched direction), c0_p the small-strain wave speed
+// sqrt((lambda + 2 mu) / rho_p), k_p the particle's stiffening (above), and
+// rho_p = m_p / V_p. The corner interpolation's large gradients run across a
+// sheared domain's thin width, the stress that stiffens the material along
+// its stretched length, so the two lift the largest frequency each on its
+// own, not as a product: on the ring at A = 1 (CPDI, 256 cells) the measured
+// omega_max (Stepper::largest_frequency) grows 6.6 times by t = 0.5 s, k_p
+// to 8.0, c_p / c0_p to about 4. Without k_p the step outgrows 2 / omega_max
+// as the ring comes to rest most twisted, and finer meshes, taking more steps
+// through that stretch, blow up first.
 template <class Shape, class Material>
-ParticleScan scan_particles(const Shape& shape, const Material& material, const Particles& P) {
+ParticleScan scan_particles(const Shape& shape, const Material& material, const Particles& P, double h) {
   const std::size_t n = P.size();
   double max_speed = 0.0;
   std::size_t first = n;
@@ -501,7 +552,11 @@ ParticleScan scan_particles(const Shape& shape, const Material& material, const 
     const double density = P.mass[p] / P.volume[p];
     const double F33 = out_of_plane_stretch<Shape::geometry>(P, p);
     const double c = std::sqrt(material.wave_modulus(P.deformation_gradient[p], F33, P.stress[p]) / density);
-    max_speed = std::max(max_speed, c + P.velocity[p].norm());
+    double speed = c;
+    if constexpr (Shape::gradients_beyond_grid_basis)
+      if (const double k = stiffening(shape, p, h); k > 1.0)
+        speed = std::max(c, k * std::sqrt(material.p_wave_modulus() / density));
+    max_speed = std::max(max_speed, speed + P.velocity[p].norm());
   }
   return {max_speed, first};
 }

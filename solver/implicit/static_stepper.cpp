@@ -113,7 +113,7 @@ class StaticStepper final : public Stepper {
   }
 
   ParticleScan scan() const override {
-    return scan_particles(Shape::bind(model_.grid, model_.particles), material_, model_.particles);
+    return scan_particles(Shape::bind(model_.grid, model_.particles), material_, model_.particles, model_.grid.h);
   }
 
   Monitors monitors() const override {

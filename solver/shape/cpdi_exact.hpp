@@ -103,6 +103,7 @@ struct CpdiExactShapeT {
   static constexpr const char* name = "cpdi-exact";
   static constexpr Geometry geometry = G;
   static constexpr bool reads_deformation_gradient = true;
+  static constexpr bool gradients_beyond_grid_basis = false;  // exact averages of the grid basis
 
   const GridGeometry* grid;
   const Vec2* position;

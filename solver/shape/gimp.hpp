@@ -72,6 +72,7 @@ struct GimpShapeT {
   static constexpr const char* name = "gimp";
   static constexpr Geometry geometry = G;
   static constexpr bool reads_deformation_gradient = false;
+  static constexpr bool gradients_beyond_grid_basis = false;  // averages of the grid basis
 
   const GridGeometry* grid;
   const Vec2* position;

@@ -59,6 +59,7 @@ struct LinearShapeT {
   static constexpr const char* name = "linear";
   static constexpr Geometry geometry = G;
   static constexpr bool reads_deformation_gradient = false;
+  static constexpr bool gradients_beyond_grid_basis = false;  // the grid basis itself
 
   const GridGeometry* grid;
   const Vec2* position;

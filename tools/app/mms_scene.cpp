@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 
@@ -120,6 +121,9 @@ class MmsCase final : public SceneCase, private RunObserver {
         loop_(time_loop_options(config)) {
     options_.geometry = setup_.geometry;
     exact_seeding_ = config_.text("seeding") == "exact";
+    if (implicit() && config_.integer("stable_step_iterations") > 0)
+      config_.reject("stable_step_iterations",
+                     "measures the stable step of explicit runs; solver = \"implicit\" takes load steps");
 #ifdef MPMVV_HAVE_CGAL
     if (exact_seeding_ && !setup_.body) throw ConfigError("this scene has no exact body: use seeding = \"centre\"");
 #endif
@@ -304,6 +308,11 @@ class MmsCase final : public SceneCase, private RunObserver {
     column("max_speed_over_wave_speed", [](const MonitorRow& r) { return r.monitors.max_mach; });
     column("max_domain_distortion", [](const MonitorRow& r) { return r.monitors.max_distortion; });
     column("particles_near_edge", [](const MonitorRow& r) { return double(r.monitors.near_edge); });
+    if (config_.integer("stable_step_iterations") > 0) {
+      column("largest_frequency", [](const MonitorRow& r) { return r.largest_frequency; });
+      column("stable_step", [](const MonitorRow& r) { return 2.0 / r.largest_frequency; });
+      column("cfl_step", [](const MonitorRow& r) { return r.cfl_step; });
+    }
   }
 
  private:
@@ -523,7 +532,12 @@ class MmsCase final : public SceneCase, private RunObserver {
     // run by any one agent (not the energy now, which a blow-up inflates).
     largest_energy_ = std::max({largest_energy_, std::abs(w.body), std::abs(w.constraints), std::abs(w.contact),
                                 std::abs(w.damping)});
-    monitor_rows_.push_back({t, m, w, created});
+    double frequency = std::numeric_limits<double>::quiet_NaN(), cfl_step = frequency;
+    if (const int iterations = int(config_.integer("stable_step_iterations")); iterations > 0) {
+      frequency = s.largest_frequency(iterations);
+      cfl_step = loop_.cfl * s.model().grid.h / s.scan().max_signal_speed;
+    }
+    monitor_rows_.push_back({t, m, w, created, frequency, cfl_step});
     const double factor = config_.real("energy_blowup_factor");
     if (created > factor * largest_energy_ && created > 0.0)
       stop_ = {"energy blow-up",
@@ -645,6 +659,7 @@ class MmsCase final : public SceneCase, private RunObserver {
     Monitors monitors;
     EnergyLedger work;
     double created;
+    double largest_frequency, cfl_step;  // with stable_step_iterations > 0
   };
   std::vector<MonitorRow> monitor_rows_;
   double initial_energy_ = 0.0, largest_energy_ = 0.0;

@@ -65,13 +65,20 @@ std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_
       {"particles_per_direction", KeyKind::integer, std::int64_t(2),
        "particles per cell along each axis (2 means 4 per cell in 2D)", 1, 16},
       {"cfl", KeyKind::real, 0.3,
-       "time step as a fraction of h / max(wave speed + particle speed); an undeformed 2D grid is stable to about "
-       "1/sqrt(2), large deformation lowers the limit (the ring at A = 1 on 256 cells fails above 0.35)",
+       "time step as a fraction of h / max(wave speed + particle speed), the wave speed raised where a sheared CPDI "
+       "domain's gradients exceed the grid basis's own (solver/stages.hpp: scan_particles); an undeformed 2D grid is "
+       "stable to about 1/sqrt(2)",
        0.0, 1.0, true, false},
       {"end_time", KeyKind::real, default_end_time, "time at which the run stops [s]", 0.0, inf, true},
       {"output_times", KeyKind::real_list, std::move(default_output_times),
        "times at which probes and errors are recorded [s]; later than end_time are dropped, end_time is always one",
        0.0, inf, true},
+      {"stable_step_iterations", KeyKind::integer, std::int64_t(0),
+       "power iterations that measure, at every output time, the largest frequency omega_max of the grid's motion "
+       "linearized about the run's state, and so its stable step 2 / omega_max, beside the step the CFL rule takes "
+       "(monitors largest_frequency, stable_step, cfl_step; explicit steps only; 0: not measured, 30 is plenty; each "
+       "iteration costs about two transfers)",
+       0, 10000},
       {"energy_blowup_factor", KeyKind::real, 10.0,
        "at an output time the run stops with 'energy blow-up' when the energy it made from nothing (kinetic plus "
        "strain energy less their start, less the work done on it) exceeds this factor times the larger of the energy "

@@ -1,0 +1,246 @@
+// The explicit step's limit under large shear (solver/stages.hpp:
+// stiffening, scan_particles) and its measurement (Stepper::largest_frequency):
+// undeformed CPDI domains leave the CFL rule as it was, sheared ones lift the
+// grid's largest frequency and the rule follows it, and the power iteration
+// finds the largest eigenvalue of the step's linearization.
+#include <gtest/gtest.h>
+
+#include "support.hpp"
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <cmath>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <Eigen/Eigenvalues>
+
+#include "solver/explicit_stepper.hpp"
+#include "solver/io/hdf5.hpp"
+#include "solver/parallel.hpp"
+#include "solver/shape/cpdi.hpp"
+#include "solver/shape/gimp.hpp"
+#include "solver/stages.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using mpmvv::CpdiShape;
+using mpmvv::GridGeometry;
+using mpmvv::Mat2;
+using mpmvv::MaterialModel;
+using mpmvv::Method;
+using mpmvv::Model;
+using mpmvv::NeoHookean;
+using mpmvv::Particles;
+using mpmvv::SolverOptions;
+using mpmvv::Vec2;
+using mpmvv::testing::rotation;
+using mpmvv::testing::simple_shear;
+
+const NeoHookean kSolid{577.0, 385.0};  // 000_1dbcb8acb6dddab9.txt eq. 2.2
+constexpr double kDensity = 1000.0;
+
+// A block of `size` x `size` reference cells, `per_direction` particles per
+// cell and axis, deformed homogeneously by F about the middle of a grid of
+// `cells` cells of size 1 and at rest in the stress of F: positions F X and
+// CPDI domains F diag(l) tile the deformed block.
+Model deformed_block(const Mat2& F, int size, int per_direction, int cells) {
+  Model model;
+  model.grid = GridGeometry::walled(Vec2::Zero(), 1.0, cells, cells);
+  const Vec2 middle(0.5 * cells, 0.5 * cells);
+  const double spacing = 1.0 / per_direction;
+  Particles& P = model.particles;
+  const int n = size * per_direction;
+  P.resize(std::size_t(n) * std::size_t(n));
+  P.half_size.assign(P.size(), Vec2(0.5 * spacing, 0.5 * spacing));
+  std::size_t p = 0;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i, ++p) {
+      // A quarter-spacing offset keeps corners off the cell lines.
+      const Vec2 X = spacing * Vec2(i + 0.5 - 0.5 * n, j + 0.5 - 0.5 * n) + Vec2(0.13, 0.07);
+      P.reference_position[p] = middle + X;
+      P.position[p] = middle + F * X;
+      P.deformation_gradient[p] = F;
+      P.mass[p] = kDensity * spacing * spacing;
+      P.reference_volume[p] = spacing * spacing;
+      P.volume[p] = F.determinant() * spacing * spacing;
+      P.stress[p] = kSolid.cauchy_stress(F);
+    }
+  return model;
+}
+
+double largest_stiffening(const Model& model) {
+  const CpdiShape shape = CpdiShape::bind(model.grid, model.particles);
+  double k = 0.0;
+  for (std::size_t p = 0; p < model.particles.size(); ++p)
+    k = std::max(k, mpmvv::stiffening(shape, p, model.grid.h));
+  return k;
+}
+
+}  // namespace
+
+// A square domain anywhere in the grid (one and two particles per direction,
+// corners on and off cell lines) has CPDI gradients within the grid basis's
+// own: the stiffening is exactly 1 and the CFL rule is what it always was.
+TEST(StableStep, SquareCpdiDomainsDoNotStiffenTheGrid) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(3.0, 5.0);
+  for (const double half : {0.25, 0.5}) {
+    Model model;
+    model.grid = GridGeometry::walled(Vec2::Zero(), 1.0, 8, 8);
+    Particles& P = model.particles;
+    P.resize(400);
+    P.half_size.assign(P.size(), Vec2(half, half));
+    for (std::size_t p = 0; p < P.size(); ++p) P.position[p] = Vec2(u(rng), u(rng));
+    P.position[0] = Vec2(4.0 + half, 4.0 + half);  // corners on a node
+    EXPECT_EQ(largest_stiffening(model), 1.0) << "half size " << half;
+  }
+}
+
+// Under shear the CPDI domains' corners straddle cell lines and their
+// gradients grow beyond the grid basis's, more the more the shear (F = R(0.3)
+// times a simple shear gamma): measured largest stiffening 1.22 (gamma = 2),
+// 2.03 (3), 2.79 (4), 3.88 (6), 5.17 (8).
+TEST(StableStep, ShearedCpdiDomainsStiffenTheGrid) {
+  double previous = 1.0;
+  for (const double gamma : {2.0, 3.0, 4.0, 6.0, 8.0}) {
+    const double k = largest_stiffening(deformed_block(rotation(0.3) * simple_shear(gamma), 4, 2, 64));
+    EXPECT_GT(k, previous) << "gamma " << gamma;
+    previous = k;
+  }
+  EXPECT_GT(previous, 4.0);
+  // GIMP averages the basis itself over its (unconvected) square: its
+  // gradients stay within the bound that the stiffening measures against.
+  const Model block = deformed_block(simple_shear(3.0), 4, 2, 32);
+  const auto gimp = mpmvv::GimpShape::bind(block.grid, block.particles);
+  for (std::size_t p = 0; p < block.particles.size(); ++p)
+    EXPECT_LE(mpmvv::gradient_sum(gimp, p), 2.0 + std::sqrt(2.0) + 1e-12);
+}
+
+namespace {
+
+// The internal force of the block moved by the grid displacement u, through
+// the public stages in the order a step applies them (eqs. 1.73-1.76, then
+// 1.70): the operator Stepper::largest_frequency iterates on, assembled here
+// column by column.
+std::vector<Vec2> internal_force(const Model& model, const std::vector<Vec2>& u) {
+  const std::size_t nodes = model.grid.node_count();
+  mpmvv::GridFields g;
+  g.resize(nodes);
+  g.velocity = u;
+  mpmvv::apply_walls(model.grid, g);
+  Particles moved = model.particles;
+  mpmvv::grid_to_particles<mpmvv::kPosition | mpmvv::kDeformation>(
+      CpdiShape::bind(model.grid, model.particles), g, moved, 1.0, 0.0);
+  mpmvv::update_stress<mpmvv::Geometry::plane_strain>(kSolid, moved);
+  mpmvv::ScatterBuffers buffers;
+  buffers.resize(mpmvv::max_threads(), nodes);
+  mpmvv::particles_to_grid<mpmvv::kInternalForce>(CpdiShape::bind(model.grid, moved), moved, buffers, g);
+  return g.force;
+}
+
+}  // namespace
+
+// The power iteration reaches the largest eigenvalue of M^-1 K, K assembled
+// densely by differences of the same force over every degree of freedom of the
+// nodes that carry mass (a sheared block, 3 x 3 reference cells, gamma = 2):
+// within 1 %.
+TEST(StableStep, PowerIterationFindsTheLargestEigenvalue) {
+  Model model = deformed_block(simple_shear(2.0), 3, 2, 16);
+  mpmvv::GridFields g;
+  g.resize(model.grid.node_count());
+  mpmvv::ScatterBuffers buffers;
+  buffers.resize(mpmvv::max_threads(), model.grid.node_count());
+  mpmvv::particles_to_grid<mpmvv::kMass>(CpdiShape::bind(model.grid, model.particles), model.particles, buffers, g);
+  std::vector<std::size_t> massive;
+  for (std::size_t i = 0; i < g.mass.size(); ++i)
+    if (g.mass[i] > 0.0) massive.push_back(i);
+  const std::size_t dofs = 2 * massive.size();
+  const std::vector<Vec2> zero(model.grid.node_count(), Vec2::Zero());
+  const std::vector<Vec2> f0 = internal_force(model, zero);
+  const double eps = 1e-7;
+  Eigen::MatrixXd A(dofs, dofs);
+  for (std::size_t c = 0; c < dofs; ++c) {
+    std::vector<Vec2> u = zero;
+    u[massive[c / 2]][int(c % 2)] = eps;
+    const std::vector<Vec2> f = internal_force(model, u);
+    for (std::size_t r = 0; r < dofs; ++r) {
+      const std::size_t node = massive[r / 2];
+      A(Eigen::Index(r), Eigen::Index(c)) = (f0[node][int(r % 2)] - f[node][int(r % 2)]) / eps / g.mass[node];
+    }
+  }
+  const Eigen::VectorXcd eigenvalues = Eigen::EigenSolver<Eigen::MatrixXd>(A, false).eigenvalues();
+  double largest = 0.0;
+  for (Eigen::Index k = 0; k < eigenvalues.size(); ++k) largest = std::max(largest, eigenvalues[k].real());
+
+  SolverOptions options;
+  options.method = Method::cpdi;
+  auto stepper = mpmvv::make_stepper(std::move(model), options, MaterialModel{kSolid}, nullptr);
+  const double omega = stepper->largest_frequency(300);
+  EXPECT_NEAR(omega * omega / largest, 1.0, 1e-2) << "omega^2 " << omega * omega << ", dense " << largest;
+}
+
+// The CFL step at cfl = 0.7 (an undeformed grid's limit, about 1/sqrt(2))
+// stays within the measured stable step 2 / omega_max of a sheared block at
+// rest, rotated or not. Measured per unit cfl, the stable step and the rule's
+// step [s]: gamma = 4: 0.289 and 0.353; gamma = 8: 0.171 and 0.182 (0.166 and
+// 0.167 rotated by 0.3): the step falls with the shear as fast as the stable
+// step does. (Undeformed: 0.90 and 0.79.)
+TEST(StableStep, CflStepStaysWithinTheMeasuredStableStepUnderShear) {
+  for (const double gamma : {2.0, 4.0, 8.0})
+    for (const double angle : {0.0, 0.3}) {
+      const Model block = deformed_block(rotation(angle) * simple_shear(gamma), 4, 2, 64);
+      SolverOptions options;
+      options.method = Method::cpdi;
+      auto stepper = mpmvv::make_stepper(block, options, MaterialModel{kSolid}, nullptr);
+      const double stable = 2.0 / stepper->largest_frequency(100);
+      const double step = 0.7 * block.grid.h / stepper->scan().max_signal_speed;
+      EXPECT_LT(step, stable) << "gamma " << gamma << ", angle " << angle;
+    }
+}
+
+// Undeformed, the measured stable step is what the CFL rule assumes, about
+// the time a wave takes to cross a cell (measured: 1.09 h / c, two particles
+// per direction; the rule's own limit, cfl 1/sqrt(2), lies below it).
+TEST(StableStep, UndeformedGridIsStableToAboutTheCellCrossingTime) {
+  const Model block = deformed_block(Mat2::Identity(), 8, 2, 16);
+  SolverOptions options;
+  options.method = Method::cpdi;
+  auto stepper = mpmvv::make_stepper(block, options, MaterialModel{kSolid}, nullptr);
+  const double c = std::sqrt(kSolid.p_wave_modulus() / kDensity);
+  const double ratio = 2.0 / stepper->largest_frequency(200) / (block.grid.h / c);
+  EXPECT_GT(ratio, 0.9);
+  EXPECT_LT(ratio, 1.2);
+}
+
+// The ring at A = 1 on 64 cells, CPDI, cfl 0.6: with the wave speed alone the
+// step outgrew the stable step as the ring came to rest most twisted and the
+// run stopped with nan at t = 0.45 s (128 cells: 0.39 s, and 0.44 s at
+// cfl 0.5, where the measured 2 / omega_max fell to 0.0030 s at t = 0.4 with
+// the step at 0.0022 s and growing; 256 cells at cfl 0.4: 0.47 s). Now it completes, and at every output time
+// the measured stable step (the monitors of `stable_step_iterations`) exceeds
+// the step the rule takes.
+TEST(StableStep, RingAtAmplitudeOneCompletesAtALargeStep) {
+  const fs::path out = fs::temp_directory_path() / "mpmvv-stable-step-ring.h5";
+  fs::remove(out);
+  const std::string command = std::string(MPMVV_BINARY) + " run " + MPMVV_SOURCE_DIR +
+                              "/suites/scenes/ring.toml -q --set cells=64 --set amplitude=1.0 --set cfl=0.6 "
+                              "--set stable_step_iterations=20 --set 'output_times=[0.2, 0.3, 0.4, 0.5, 0.6, 0.7]' "
+                              "-o " + out.string() + " > /dev/null 2>&1";
+  ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  const mpmvv::h5::File file = mpmvv::h5::File::open_read(out.string());
+  const mpmvv::h5::Group root = file.root();
+  EXPECT_EQ(root.attribute_string("status"), "completed") << root.attribute_string("failure_reason");
+  const mpmvv::h5::Group monitors = root.open_group("probes").open_group("monitors");
+  const std::vector<double> stable = monitors.read_doubles("stable_step");
+  const std::vector<double> step = monitors.read_doubles("cfl_step");
+  ASSERT_EQ(stable.size(), 7u);  // the output times and the end time
+  for (std::size_t k = 0; k < stable.size(); ++k) EXPECT_LT(step[k], stable[k]) << "output " << k;
+  // The shear raises the largest frequency: the stable step at t = 0.5
+  // (most twisted) is a fraction of the one at the start.
+  EXPECT_LT(stable[3], 0.3 * stable[0]);
+}
