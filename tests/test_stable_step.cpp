@@ -244,3 +244,31 @@ TEST(StableStep, RingAtAmplitudeOneCompletesAtALargeStep) {
   // (most twisted) is a fraction of the one at the start.
   EXPECT_LT(stable[3], 0.3 * stable[0]);
 }
+
+// The scan evaluates a particle's stencil only where the bound
+// CpdiShape::gradient_sum_bound says it could set a new largest speed; the
+// maximum is then exact only if the bound holds: sum_g |G_gp| never exceeds
+// it, for random domains (sheared, stretched, rotated; across cell lines) in
+// plane strain and in r-z.
+TEST(StableStep, GradientSumBoundHoldsForRandomDomains) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> where(4.0, 12.0);
+  Model model;
+  model.grid = GridGeometry::walled(Vec2::Zero(), 1.0, 16, 16);
+  Particles& P = model.particles;
+  P.resize(2000);
+  P.half_size.assign(P.size(), Vec2(0.25, 0.25));
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    P.position[p] = Vec2(where(rng), where(rng));
+    P.deformation_gradient[p] =
+        rotation(where(rng)) * simple_shear(0.5 * where(rng) - 2.0) * mpmvv::testing::random_deformation(rng, 0.6, 0.2);
+  }
+  const CpdiShape plane = CpdiShape::bind(model.grid, P);
+  const auto axisymmetric = mpmvv::CpdiShapeT<mpmvv::Geometry::axisymmetric>::bind(model.grid, P);
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    const double bound = plane.gradient_sum_bound(p);
+    EXPECT_TRUE(std::isfinite(bound)) << "particle " << p;
+    EXPECT_LE(mpmvv::gradient_sum(plane, p), bound * (1.0 + 1e-12)) << "particle " << p;
+    EXPECT_LE(mpmvv::gradient_sum(axisymmetric, p), axisymmetric.gradient_sum_bound(p) * (1.0 + 1e-12));
+  }
+}

@@ -64,6 +64,45 @@ struct CpdiShapeT {
     return position[p] + corner_xi[c] * s.col(0) + corner_eta[c] * s.col(1);
   }
 
+  // The corner factors of G_gp = sum_c S_g(x_c) g_c (above, with the r-z
+  // weights), for the corners in the order of corner_xi, corner_eta.
+  void corner_gradients(std::size_t p, const Mat2& s, Vec2* g) const {
+    // s^-T = [[s11, -s10], [-s01, s00]] / det s.
+    const double inv_det = gradient_scale / determinant(s);
+    double weight_a = 0.0, weight_b = 0.0;
+    if constexpr (G == Geometry::axisymmetric) {
+      const double weight_r = 1.0 / (3.0 * position[p].x());
+      weight_a = s(0, 0) * weight_r;
+      weight_b = s(0, 1) * weight_r;
+    }
+    for (int c = 0; c < 4; ++c) {
+      const double xi = corner_xi[c], eta = corner_eta[c];
+      double gxi = 0.25 * xi, geta = 0.25 * eta;
+      if constexpr (G == Geometry::axisymmetric) {
+        gxi *= 1.0 + weight_b * eta;
+        geta *= 1.0 + weight_a * xi;
+      }
+      g[c] = inv_det * Vec2(s(1, 1) * gxi - s(1, 0) * geta, s(0, 0) * geta - s(0, 1) * gxi);
+    }
+  }
+
+  // An upper bound of sum_g |G_gp| without the grid: the factors g_c sum to
+  // zero, so G_gp = sum_c (S_g(x_c) - S_g(x_p)) g_c, and over the nodes
+  // sum_g |S_g(a) - S_g(b)| is at most 2 (|a_x - b_x| + |a_y - b_y|) / h
+  // (the bilinear hats, each a product of 1D hats of slope 1 / h) and at
+  // most 2 (two partitions of unity).
+  double gradient_sum_bound(std::size_t p) const {
+    const Mat2 s = domain(p);
+    Vec2 g[4];
+    corner_gradients(p, s, g);
+    double bound = 0.0;
+    for (int c = 0; c < 4; ++c) {
+      const Vec2 offset = corner_xi[c] * s.col(0) + corner_eta[c] * s.col(1);
+      bound += g[c].norm() * std::min(2.0, 2.0 * offset.cwiseAbs().sum() / grid->h);
+    }
+    return bound;
+  }
+
   // The corners' shares of the node values: corner c passes S_g(x_c) to each
   // of the four nodes of its cell with the factors of S_gp, G_gp and <S/r>
   // above. A domain within 2 x 2 cells (every domain up to a cell across,
@@ -73,8 +112,6 @@ struct CpdiShapeT {
   void evaluate(std::size_t p, Stencil<stencil_size>& st) const {
     const GridGeometry& g = *grid;
     const Mat2 s = domain(p);
-    // s^-T = [[s11, -s10], [-s01, s00]] / det s.
-    const double inv_det = gradient_scale / determinant(s);
     double weight_r = 0.0, weight_a = 0.0, weight_b = 0.0;
     if constexpr (G == Geometry::axisymmetric) {
       weight_r = 1.0 / (3.0 * position[p].x());
@@ -85,16 +122,12 @@ struct CpdiShapeT {
     int cell_i[4], cell_j[4];
     double fx[4], fy[4], corner_weight[4];
     Vec2 corner_gradient[4];
+    corner_gradients(p, s, corner_gradient);
     for (int c = 0; c < 4; ++c) {
       const double xi = corner_xi[c], eta = corner_eta[c];
-      double cw = 0.25, gxi = 0.25 * xi, geta = 0.25 * eta;
-      if constexpr (G == Geometry::axisymmetric) {
-        cw *= 1.0 + weight_a * xi + weight_b * eta;
-        gxi *= 1.0 + weight_b * eta;
-        geta *= 1.0 + weight_a * xi;
-      }
+      double cw = 0.25;
+      if constexpr (G == Geometry::axisymmetric) cw *= 1.0 + weight_a * xi + weight_b * eta;
       corner_weight[c] = cw;
-      corner_gradient[c] = inv_det * Vec2(s(1, 1) * gxi - s(1, 0) * geta, s(0, 0) * geta - s(0, 1) * gxi);
       const Vec2 x = grid_coordinate(g, corner(p, s, c));
       cell_i[c] = cell_index(x.x(), g.cells_x);
       cell_j[c] = cell_index(x.y(), g.cells_y);
