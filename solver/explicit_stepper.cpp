@@ -12,6 +12,7 @@
 #include "shape/cpdi_exact.hpp"
 #include "shape/gimp.hpp"
 #include "shape/linear.hpp"
+#include "shape/total_lagrangian.hpp"
 #include "monitors.hpp"
 
 namespace mpmvv {
@@ -60,6 +61,7 @@ class ExplicitStepper final : public Stepper {
         contact_(std::move(stages.contact)),
         second_(stages.second_body) {
     buffers_.resize(max_threads(), model_.grid.node_count());
+    if constexpr (requires { Shape::total_lagrangian; }) tracer_reference_ = model_.tracers;
     if (body_force_) {
       body_force_->prepare(model_.particles);
       model_.particles.body_force.assign(model_.particles.size(), Vec2::Zero());
@@ -393,7 +395,11 @@ class ExplicitStepper final : public Stepper {
   }
 
   void move_tracers(double dt) {
-    if (!model_.tracers.empty()) advect_tracers(model_.grid, fields_, model_.tracers, dt);
+    if (model_.tracers.empty()) return;
+    if constexpr (requires { Shape::total_lagrangian; })
+      advect_tracers(model_.grid, fields_, model_.tracers, dt, &tracer_reference_);
+    else
+      advect_tracers(model_.grid, fields_, model_.tracers, dt);
   }
 
   Scheme scheme_;
@@ -418,6 +424,7 @@ class ExplicitStepper final : public Stepper {
   ScatterBuffers buffers_;
   std::vector<Vec2> next_position_;  // MUSL only: x_{n+1} while x_n still sets the weights
   std::vector<Mat2> step_start_deformation_;  // USF with CPDI only: F_n, which sets the domains
+  std::vector<Vec2> tracer_reference_;         // total Lagrangian: where each tracer reads the grid
 };
 
 template <class Shape>
@@ -437,6 +444,9 @@ std::unique_ptr<Stepper> make_for_shape(Model model, const SolverOptions& o, con
 template <Geometry G>
 std::unique_ptr<Stepper> make_for_geometry(Model model, const SolverOptions& o, const MaterialModel& material,
                                            SceneStages stages) {
+  if constexpr (G == Geometry::plane_strain)
+    if (o.formulation == Formulation::total)
+      return make_for_shape<TotalLagrangianGimpShape>(std::move(model), o, material, std::move(stages));
   switch (o.method) {
     case Method::linear: return make_for_shape<LinearShapeT<G>>(std::move(model), o, material, std::move(stages));
     case Method::gimp: return make_for_shape<GimpShapeT<G>>(std::move(model), o, material, std::move(stages));
@@ -485,6 +495,20 @@ std::unique_ptr<Stepper> make_stepper(Model model, const SolverOptions& options,
     if (options.geometry != Geometry::plane_strain)
       throw std::invalid_argument("split_domains_beyond is plane strain only");
     if (stages.second_body > 0) throw std::invalid_argument("split_domains_beyond serves one body only");
+  }
+  if (options.formulation == Formulation::total) {
+    // What the reference grid cannot do yet, or does not need.
+    if (options.method != Method::gimp)
+      throw std::invalid_argument(fmt::format("the total Lagrangian formulation weighs particles with method gimp "
+                                              "(their square reference domains tile the body), not {}",
+                                              to_string(options.method)));
+    if (options.geometry != Geometry::plane_strain)
+      throw std::invalid_argument("the total Lagrangian formulation is plane strain only");
+    if (stages.contact || stages.second_body > 0)
+      throw std::invalid_argument("the total Lagrangian formulation has no contact: its grid moves with one body");
+    if (options.dilatation == Dilatation::cell_averaged)
+      throw std::invalid_argument("the total Lagrangian formulation takes dilatation = particle or node-smoothed "
+                                  "(cell-averaged bins particles by their current cell)");
   }
   if (!(options.bulk_viscosity_linear >= 0.0 && options.bulk_viscosity_quadratic >= 0.0))
     throw std::invalid_argument("the bulk viscosity coefficients must be zero (none) or positive");

@@ -23,6 +23,10 @@ enum class Scheme { usl, usf, musl };
 // cell's mean (average_cell_dilatation, eqs. 1.82-1.84), or the mean its
 // nodes hold (smooth_node_dilatation); stages.hpp.
 enum class Dilatation { particle, cell_averaged, node_smoothed };
+// Where the grid is: fixed in space, the particles moving through it
+// (updated), or the body's reference configuration, each particle weighed at
+// its reference position for the whole run (total; shape/total_lagrangian.hpp).
+enum class Formulation { updated, total };
 
 const char* to_string(Method m);
 const char* to_string(Scheme s);
@@ -39,6 +43,7 @@ struct SolverOptions {
   // 1 in every real run.
   double cpdi_gradient_scale = 1.0;
   Dilatation dilatation = Dilatation::particle;
+  Formulation formulation = Formulation::updated;
   // CPDI only: a domain longer than this many cells along one of its vectors
   // is split in two along it after a step (split.hpp); 0: never.
   double split_domains_beyond = 0.0;

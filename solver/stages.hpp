@@ -436,16 +436,22 @@ ViscousStep add_bulk_viscosity(const Shape& shape, Particles& P, const std::vect
 // the nodes beyond the body, which carry only a sliver of mass and whatever
 // velocity that sliver gives them, do not drag a tracer on the surface along.
 // A tracer that leaves the grid, or finds no mass around it, becomes NaN.
+//
+// Under the total Lagrangian formulation the grid is the reference
+// configuration: `reference` then holds each tracer's reference position,
+// where the grid is read, while `tracers` holds where it is now.
 inline void advect_tracers(const GridGeometry& grid, const GridFields& g, std::vector<Vec2>& tracers,
-                           double dt) {
-  for (Vec2& x : tracers) {
-    if (!inside_cells(grid, grid_coordinate(grid, x))) {
+                           double dt, const std::vector<Vec2>* reference = nullptr) {
+  for (std::size_t t = 0; t < tracers.size(); ++t) {
+    Vec2& x = tracers[t];
+    const Vec2& at = reference ? (*reference)[t] : x;
+    if (!inside_cells(grid, grid_coordinate(grid, at)) || !x.allFinite()) {
       x.setConstant(std::numeric_limits<double>::quiet_NaN());
       continue;
     }
     int node[4];
     double w[4];
-    bilinear_cell_weights(grid, x, node, w);
+    bilinear_cell_weights(grid, at, node, w);
     Vec2 momentum = Vec2::Zero();
     double mass = 0.0;
     for (int k = 0; k < 4; ++k) {
@@ -561,6 +567,9 @@ ParticleScan scan_particles(const Shape& shape, const Material& material, const 
     const double c = std::sqrt(material.wave_modulus(P.deformation_gradient[p], F33, P.stress[p]) / density);
     const double v = P.velocity[p].norm();
     double speed = c;
+    // The total Lagrangian formulation: a wave crosses the current image of a
+    // reference cell, F_p h along its most compressed direction.
+    if constexpr (requires { shape.cell_stretch(p); }) speed = c / std::min(1.0, shape.cell_stretch(p));
     if constexpr (Shape::gradients_beyond_grid_basis) {
       // The stencil only where the particle could set a new largest speed:
       // the bound below is exact-safe, so the maximum is what evaluating

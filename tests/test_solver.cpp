@@ -164,6 +164,45 @@ TEST(Solver, CpdiUsfConservesMomentum) {
   EXPECT_LT(momentum_change(Method::cpdi, Scheme::usf), 1e-12);
 }
 
+// The total Lagrangian formulation (gimp, every scheme) conserves momentum
+// like the others: its node masses are the reference weights' and its forces
+// sum to zero over the nodes (the reference gradients do).
+TEST(Solver, TotalLagrangianConservesMomentum) {
+  for (Scheme scheme : kSchemes) {
+    SCOPED_TRACE(to_string(scheme));
+    Model model = disk_model(Method::gimp);
+    for (std::size_t p = 0; p < model.particles.size(); ++p) {
+      const Vec2 x = model.particles.position[p];
+      model.particles.velocity[p] = Vec2(0.1 * std::sin(x.y()) + 0.02, 0.05 * x.x() - 0.01);
+    }
+    const Vec2 before = total_momentum(model.particles);
+    const double scale = total_momentum_magnitude(model.particles);
+    const double dt = stable_step(model);
+    SolverOptions options{Method::gimp, scheme};
+    options.formulation = mpmvv::Formulation::total;
+    auto stepper = mpmvv::make_stepper(std::move(model), options, MaterialModel{kSolid}, nullptr);
+    advance(*stepper, 20, dt);
+    EXPECT_LT((total_momentum(stepper->model().particles) - before).norm() / scale, 1e-12);
+  }
+}
+
+// The total Lagrangian formulation takes what its reference grid can do and
+// says what it cannot: methods other than gimp, r-z, contact.
+TEST(Solver, TotalLagrangianRefusesWhatItCannotDo) {
+  for (Method method : {Method::linear, Method::cpdi, Method::cpdi_exact}) {
+    SolverOptions options{method, Scheme::usl};
+    options.formulation = mpmvv::Formulation::total;
+    EXPECT_THROW(mpmvv::make_stepper(disk_model(method), options, MaterialModel{kSolid}, nullptr),
+                 std::invalid_argument)
+        << to_string(method);
+  }
+  SolverOptions rz{Method::gimp, Scheme::usl};
+  rz.formulation = mpmvv::Formulation::total;
+  rz.geometry = mpmvv::Geometry::axisymmetric;
+  EXPECT_THROW(mpmvv::make_stepper(disk_model(Method::gimp), rz, MaterialModel{kSolid}, nullptr),
+               std::invalid_argument);
+}
+
 // ---------------------------------------------------------------- rigid rotation
 
 constexpr double kSpin = 0.5;  // omega [rad/s]

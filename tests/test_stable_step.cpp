@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <cmath>
+#include <complex>
 #include <memory>
 #include <random>
 #include <string>
@@ -23,6 +24,7 @@
 #include "solver/parallel.hpp"
 #include "solver/shape/cpdi.hpp"
 #include "solver/shape/gimp.hpp"
+#include "solver/shape/total_lagrangian.hpp"
 #include "solver/stages.hpp"
 
 namespace {
@@ -127,6 +129,7 @@ namespace {
 // the public stages in the order a step applies them (eqs. 1.73-1.76, then
 // 1.70): the operator Stepper::largest_frequency iterates on, assembled here
 // column by column.
+template <class Shape>
 std::vector<Vec2> internal_force(const Model& model, const std::vector<Vec2>& u) {
   const std::size_t nodes = model.grid.node_count();
   mpmvv::GridFields g;
@@ -134,14 +137,52 @@ std::vector<Vec2> internal_force(const Model& model, const std::vector<Vec2>& u)
   g.velocity = u;
   mpmvv::apply_walls(model.grid, g);
   Particles moved = model.particles;
-  mpmvv::grid_to_particles<mpmvv::kPosition | mpmvv::kDeformation>(
-      CpdiShape::bind(model.grid, model.particles), g, moved, 1.0, 0.0);
+  mpmvv::grid_to_particles<mpmvv::kPosition | mpmvv::kDeformation>(Shape::bind(model.grid, model.particles), g,
+                                                                     moved, 1.0, 0.0);
   mpmvv::update_stress<mpmvv::Geometry::plane_strain>(kSolid, moved);
   mpmvv::ScatterBuffers buffers;
   buffers.resize(mpmvv::max_threads(), nodes);
-  mpmvv::particles_to_grid<mpmvv::kInternalForce>(CpdiShape::bind(model.grid, moved), moved, buffers, g);
+  mpmvv::particles_to_grid<mpmvv::kInternalForce>(Shape::bind(model.grid, moved), moved, buffers, g);
   return g.force;
 }
+
+// M^-1 K of the step's linearization about the model's state, densely, over
+// both components of every node that carries mass, by differences of
+// internal_force (K u = f(0) - f(u)); with K itself.
+template <class Shape>
+struct DenseOperator {
+  Eigen::MatrixXd A, K;
+};
+
+template <class Shape>
+DenseOperator<Shape> dense_operator(const Model& model) {
+  mpmvv::GridFields g;
+  g.resize(model.grid.node_count());
+  mpmvv::ScatterBuffers buffers;
+  buffers.resize(mpmvv::max_threads(), model.grid.node_count());
+  mpmvv::particles_to_grid<mpmvv::kMass>(Shape::bind(model.grid, model.particles), model.particles, buffers, g);
+  std::vector<std::size_t> massive;
+  for (std::size_t i = 0; i < g.mass.size(); ++i)
+    if (g.mass[i] > 0.0) massive.push_back(i);
+  const Eigen::Index dofs = Eigen::Index(2 * massive.size());
+  const std::vector<Vec2> zero(model.grid.node_count(), Vec2::Zero());
+  const std::vector<Vec2> f0 = internal_force<Shape>(model, zero);
+  const double eps = 1e-7;
+  DenseOperator<Shape> d{Eigen::MatrixXd(dofs, dofs), Eigen::MatrixXd(dofs, dofs)};
+  for (Eigen::Index c = 0; c < dofs; ++c) {
+    std::vector<Vec2> u = zero;
+    u[massive[std::size_t(c / 2)]][int(c % 2)] = eps;
+    const std::vector<Vec2> f = internal_force<Shape>(model, u);
+    for (Eigen::Index r = 0; r < dofs; ++r) {
+      const std::size_t node = massive[std::size_t(r / 2)];
+      d.K(r, c) = (f0[node][int(r % 2)] - f[node][int(r % 2)]) / eps;
+      d.A(r, c) = d.K(r, c) / g.mass[node];
+    }
+  }
+  return d;
+}
+
+double asymmetry(const Eigen::MatrixXd& K) { return (K - K.transpose()).norm() / K.norm(); }
 
 }  // namespace
 
@@ -151,28 +192,7 @@ std::vector<Vec2> internal_force(const Model& model, const std::vector<Vec2>& u)
 // within 1 %.
 TEST(StableStep, PowerIterationFindsTheLargestEigenvalue) {
   Model model = deformed_block(simple_shear(2.0), 3, 2, 16);
-  mpmvv::GridFields g;
-  g.resize(model.grid.node_count());
-  mpmvv::ScatterBuffers buffers;
-  buffers.resize(mpmvv::max_threads(), model.grid.node_count());
-  mpmvv::particles_to_grid<mpmvv::kMass>(CpdiShape::bind(model.grid, model.particles), model.particles, buffers, g);
-  std::vector<std::size_t> massive;
-  for (std::size_t i = 0; i < g.mass.size(); ++i)
-    if (g.mass[i] > 0.0) massive.push_back(i);
-  const std::size_t dofs = 2 * massive.size();
-  const std::vector<Vec2> zero(model.grid.node_count(), Vec2::Zero());
-  const std::vector<Vec2> f0 = internal_force(model, zero);
-  const double eps = 1e-7;
-  Eigen::MatrixXd A(dofs, dofs);
-  for (std::size_t c = 0; c < dofs; ++c) {
-    std::vector<Vec2> u = zero;
-    u[massive[c / 2]][int(c % 2)] = eps;
-    const std::vector<Vec2> f = internal_force(model, u);
-    for (std::size_t r = 0; r < dofs; ++r) {
-      const std::size_t node = massive[r / 2];
-      A(Eigen::Index(r), Eigen::Index(c)) = (f0[node][int(r % 2)] - f[node][int(r % 2)]) / eps / g.mass[node];
-    }
-  }
+  const Eigen::MatrixXd A = dense_operator<CpdiShape>(model).A;
   const Eigen::VectorXcd eigenvalues = Eigen::EigenSolver<Eigen::MatrixXd>(A, false).eigenvalues();
   double largest = 0.0;
   for (Eigen::Index k = 0; k < eigenvalues.size(); ++k) largest = std::max(largest, eigenvalues[k].real());
@@ -182,6 +202,41 @@ TEST(StableStep, PowerIterationFindsTheLargestEigenvalue) {
   auto stepper = mpmvv::make_stepper(std::move(model), options, MaterialModel{kSolid}, nullptr);
   const double omega = stepper->largest_frequency(300);
   EXPECT_NEAR(omega * omega / largest, 1.0, 1e-2) << "omega^2 " << omega * omega << ", dense " << largest;
+}
+
+// The largest rate at which a mode of u'' = -A u grows by itself: over the
+// eigenvalues lambda of A, the largest real part of sqrt(-lambda) (a negative
+// lambda grows as exp(sqrt(-lambda) t), a complex one oscillates and grows).
+double growth_rate(const Eigen::MatrixXd& A) {
+  const Eigen::VectorXcd eigenvalues = Eigen::EigenSolver<Eigen::MatrixXd>(A, false).eigenvalues();
+  double rate = 0.0;
+  for (Eigen::Index k = 0; k < eigenvalues.size(); ++k)
+    rate = std::max(rate, std::abs(std::sqrt(std::complex<double>(-eigenvalues[k])).real()));
+  return rate;
+}
+
+// Why a stressed state can break whatever the step (the ring at A = 1 on 600
+// cells, suites/ring-sandia.toml): under the updated formulation the weights
+// follow the particles through the grid, and the linearized force of a
+// stressed block is not symmetric; its eigenvalues turn complex, and modes
+// grow. Measured for a CPDI block (3 x 3 cells, h = 1 m, simple shear gamma):
+// |K - K^T| / |K| 5e-8 (unstressed), 0.12 (0.5), 0.26 (1), 0.46 (2), and
+// growth rates up to 0.09, 0.22, 0.43 1/s against omega_max 2.36, 2.39, 2.67
+// rad/s: as both scale with 1 / h, a finer mesh grows them faster. The total
+// Lagrangian formulation (uGIMP over the reference grid) is the gradient of a
+// stored energy: symmetric, with no growing mode, at every shear.
+TEST(StableStep, TotalLagrangianLinearizationIsSymmetricUnderShear) {
+  const auto updated0 = dense_operator<CpdiShape>(deformed_block(Mat2::Identity(), 3, 2, 16));
+  EXPECT_LT(asymmetry(updated0.K), 1e-6);
+  for (const double gamma : {1.0, 2.0}) {
+    const Model block = deformed_block(simple_shear(gamma), 3, 2, 16);
+    const auto updated = dense_operator<CpdiShape>(block);
+    const auto total = dense_operator<mpmvv::TotalLagrangianGimpShape>(block);
+    EXPECT_GT(asymmetry(updated.K), 0.2) << "gamma " << gamma;
+    EXPECT_GT(growth_rate(updated.A), 0.2) << "gamma " << gamma;
+    EXPECT_LT(asymmetry(total.K), 1e-5) << "gamma " << gamma;
+    EXPECT_LT(growth_rate(total.A), 1e-3) << "gamma " << gamma;
+  }
 }
 
 // The CFL step at cfl = 0.7 (an undeformed grid's limit, about 1/sqrt(2))
@@ -200,6 +255,13 @@ TEST(StableStep, CflStepStaysWithinTheMeasuredStableStepUnderShear) {
       const double stable = 2.0 / stepper->largest_frequency(100);
       const double step = 0.7 * block.grid.h / stepper->scan().max_signal_speed;
       EXPECT_LT(step, stable) << "gamma " << gamma << ", angle " << angle;
+      // The total Lagrangian step shrinks with the smallest stretch of F.
+      SolverOptions total;
+      total.method = Method::gimp;
+      total.formulation = mpmvv::Formulation::total;
+      auto reference = mpmvv::make_stepper(block, total, MaterialModel{kSolid}, nullptr);
+      EXPECT_LT(0.7 * block.grid.h / reference->scan().max_signal_speed, 2.0 / reference->largest_frequency(100))
+          << "total Lagrangian, gamma " << gamma << ", angle " << angle;
     }
 }
 

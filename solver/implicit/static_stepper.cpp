@@ -511,6 +511,8 @@ std::unique_ptr<Stepper> make_static_stepper(Model model, const SolverOptions& o
     throw std::invalid_argument("the dilatation remedies (cell-averaged, node-smoothed) serve the explicit step only");
   if (options.bulk_viscosity_linear != 0.0 || options.bulk_viscosity_quadratic != 0.0)
     throw std::invalid_argument("bulk viscosity serves the explicit step only (a static step has no rate)");
+  if (options.formulation != Formulation::updated)
+    throw std::invalid_argument("the implicit static step has the updated formulation only");
   switch (options.method) {
     case Method::linear: return make_for_shape<LinearShape>(std::move(model), material, std::move(stages), o);
     case Method::gimp: return make_for_shape<GimpShapeT<Geometry::plane_strain>>(std::move(model), material, std::move(stages), o);

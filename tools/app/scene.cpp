@@ -48,6 +48,12 @@ std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_
        "each takes the mean dilatation of the nodes it reaches, with the method's weights (removes a J that varies "
        "from particle to particle, which the grid cannot push back on)",
        -inf, inf, false, false, {"particle", "cell-averaged", "node-smoothed"}},
+      {"formulation", KeyKind::text, std::string("updated"),
+       "updated: the grid is fixed in space and the particles move through it (the usual MPM); total: the grid is "
+       "the body's reference configuration and each particle is weighed at its reference position for the whole "
+       "run (total Lagrangian MPM; method gimp, plane strain, no contact): no cell crossing, and the linearized "
+       "step of a stressed body stays symmetric (solver/shape/total_lagrangian.hpp)",
+       -inf, inf, false, false, {"updated", "total"}},
       {"split_domains_beyond", KeyKind::real, 0.0,
        "cpdi only: after a step, a particle whose domain is longer than this many cells along one of its vectors is "
        "replaced by its two halves along it (0: never); keeps the corner interpolation of CPDI within a few cells "
@@ -100,6 +106,7 @@ SolverOptions solver_options(const Config& c) {
   o.dilatation = d == "cell-averaged"   ? Dilatation::cell_averaged
                  : d == "node-smoothed" ? Dilatation::node_smoothed
                                         : Dilatation::particle;
+  o.formulation = c.text("formulation") == "total" ? Formulation::total : Formulation::updated;
   o.split_domains_beyond = c.real("split_domains_beyond");
   o.bulk_viscosity_linear = c.real("bulk_viscosity");
   o.bulk_viscosity_quadratic = c.real("bulk_viscosity_quadratic");
