@@ -560,17 +560,26 @@ HEALTH_MAX_CASES = 12          # with more cases than this the run-health figure
 def health_selection(cases):
     """The cases the run-health figure draws, in the order given, and whether that is
     a selection: all of them when there are at most HEALTH_MAX_CASES; else, so that
-    the figure stays readable, those that did not complete plus the finest completed
-    case (smallest h; the last listed on a tie) of each value of the `method` key."""
+    the figure stays readable, two per value of the `method` key: the finest
+    completed case (smallest h; the last listed on a tie) and the finest case that
+    did not complete (smallest h; the earliest failure on a tie)."""
     if len(cases) <= HEALTH_MAX_CASES:
         return list(cases), False
-    finest = {}
+
+    def failure_time(case):
+        t = float(case.attribute("failure_time"))
+        return t if math.isfinite(t) else float("inf")
+
+    finest, failed = {}, {}
     for case in cases:
         method = str(case.keys.get("method", ""))
-        if case.completed and (method not in finest or case.h <= finest[method].h):
-            finest[method] = case
-    kept = {c.id for c in finest.values()}
-    return [c for c in cases if not c.completed or c.id in kept], True
+        if case.completed:
+            if method not in finest or case.h <= finest[method].h:
+                finest[method] = case
+        elif method not in failed or (case.h, failure_time(case)) < (failed[method].h, failure_time(failed[method])):
+            failed[method] = case
+    kept = {c.id for c in finest.values()} | {c.id for c in failed.values()}
+    return [c for c in cases if c.id in kept], True
 
 
 def health_label(series, case, monitors):
@@ -631,8 +640,9 @@ def health_figure(study, all_series, directory):
                "unstable above 1 (dotted). x: the failure time of a failed case, at the height of its "
                "last recorded value (dotted from its last output).")
     if selected:
-        caption += (f" {len(chosen)} of the {len(found)} cases with monitors are drawn: those that failed and the "
-                    f"finest completed case of each method.")
+        caption += (f" {len(chosen)} of the {len(found)} cases with monitors are drawn: for each method the finest "
+                    f"completed case and the finest case that did not complete (the earliest failure on a tie); the "
+                    f"stability map shows every case.")
     if without:
         caption += f" {without} case(s) of the study have results without /probes/monitors (written before them)."
     return FigureEntry(study, path, caption)

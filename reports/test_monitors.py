@@ -158,9 +158,9 @@ def test_energy_balance_scale_on_hand_made_arrays():
     assert np.allclose(ratio[:3], 0.1) and np.isnan(ratio[3])
 
 
-def test_many_cases_draw_the_failed_and_the_finest_completed_of_each_method():
-    """Requirement: with more than report.HEALTH_MAX_CASES cases the figure draws only
-    the cases that failed and the finest completed case of each method."""
+def test_many_cases_draw_the_finest_failed_and_completed_of_each_method():
+    """Requirement: with more than report.HEALTH_MAX_CASES cases the figure draws, per
+    method, the finest completed case and the finest case that did not complete."""
     def case(method, cells, status="completed"):
         results = CaseResults({"h": 1.0 / cells, "status": status}, np.zeros(0), {}, {})
         return Case(f"{method}-{cells}", "s", {"method": method, "cells": cells}, status, "", Path("x.h5"),
@@ -169,6 +169,11 @@ def test_many_cases_draw_the_failed_and_the_finest_completed_of_each_method():
              for m in ("linear", "cpdi") for n in (8, 16, 32, 64, 128, 256, 512)]
     chosen, selected = report.health_selection(cases)
     assert selected and [c.id for c in chosen] == ["linear-256", "linear-512", "cpdi-512"]
+    # many failures: only the finest of them per method
+    failing = [case(m, n, "failed" if n >= 64 else "completed")
+               for m in ("linear", "gimp") for n in (8, 16, 32, 64, 128, 256, 512)]
+    chosen, selected = report.health_selection(failing)
+    assert selected and [c.id for c in chosen] == ["linear-32", "linear-512", "gimp-32", "gimp-512"]
     few, selected = report.health_selection(cases[:report.HEALTH_MAX_CASES])
     assert not selected and len(few) == report.HEALTH_MAX_CASES
 
