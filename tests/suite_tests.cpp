@@ -177,6 +177,25 @@ TEST(SuiteRunner, ResumeRunsOnlyWhatIsMissing) {
   EXPECT_EQ(count(read(dir / "out" / "manifest.json"), "kept from an earlier run"), 2);
 }
 
+// --only runs the cases whose id the regular expression finds and leaves the
+// others pending, to be run (or kept) by a later run; a bad expression is bad
+// input.
+TEST(SuiteRunner, OnlyRunsTheSelectedCases) {
+  const fs::path dir = scratch("only");
+  const fs::path suite = write(dir / "s.toml", small_suite(3));
+  const std::string run = std::string(MPMVV_BINARY) + " suite " + suite.string() + " -j 2 -q -o " + (dir / "out").string();
+  ASSERT_EQ(shell(run + " --only 'cells=(8|16)$'"), 0);
+  std::string manifest = read(dir / "out" / "manifest.json");
+  EXPECT_EQ(count(manifest, "\"status\": \"completed\""), 2) << manifest;
+  EXPECT_EQ(count(manifest, "\"status\": \"pending\""), 1) << manifest;
+  EXPECT_FALSE(fs::exists(dir / "out/cases/square-cells=12.h5"));
+  ASSERT_EQ(shell(run), 0);
+  manifest = read(dir / "out" / "manifest.json");
+  EXPECT_EQ(count(manifest, "\"status\": \"completed\""), 3) << manifest;
+  EXPECT_EQ(count(manifest, "kept from an earlier run"), 2) << manifest;
+  EXPECT_EQ(shell(run + " --only '('"), 2);
+}
+
 // Results written before a key existed are kept when that key is at its
 // default now (the behaviour the key was added with) and rerun otherwise; a
 // stored key with another value, or one the scene no longer has, is a change.

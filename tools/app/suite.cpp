@@ -639,11 +639,21 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
     if (rank == 0) fmt::print(err, "mpmvv suite: {}\n", e.what());
     return finish_mpi(2);
   }
+  std::regex only;
+  try {
+    only = std::regex(request.only.empty() ? std::string(".") : request.only);
+  } catch (const std::regex_error& e) {
+    if (rank == 0) fmt::print(err, "mpmvv suite: --only '{}': not a regular expression ({})\n", request.only, e.what());
+    return finish_mpi(2);
+  }
+  // --only: the cases the request selects; the others stay as an earlier run left them.
+  auto selected = [&](const SuiteCase& c) { return request.only.empty() || std::regex_search(c.id, only); };
   if (request.list) {
     if (rank == 0) {
       fmt::print(out, "suite {}: {} cases, timeout {} s{}\n", suite.file, suite.cases.size(), suite.timeout_seconds,
                  suite.description.empty() ? "" : "\n" + suite.description);
       for (const SuiteCase& c : suite.cases) {
+        if (!selected(c)) continue;
         std::string settings;
         for (const std::string& o : c.overrides)
           settings += o.find(' ') == std::string::npos ? " --set " + o : " --set '" + o + "'";
@@ -694,7 +704,7 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
 
   // This rank's share, and what an earlier run already finished.
   std::vector<std::size_t> queue;
-  std::size_t resumed = 0;
+  std::size_t resumed = 0, unselected = 0;
   for (std::size_t i = 0; i < n; ++i) {
     if (i % std::size_t(ranks) != std::size_t(rank)) continue;
     if (const auto done = finished_state(results_of(i), suite.cases[i])) {
@@ -702,8 +712,10 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
       state[i].detail = (state[i].detail.empty() ? "" : state[i].detail + "; ") + "kept from an earlier run";
       record(i);
       ++resumed;
-    } else {
+    } else if (selected(suite.cases[i])) {
       queue.push_back(i);
+    } else {
+      ++unselected;
     }
   }
 
@@ -715,8 +727,10 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
   const bool tty = isatty(fileno(stderr));
   const std::string prefix = ranks > 1 ? fmt::format("[rank {}] ", rank) : "";
   if (!request.quiet)
-    fmt::print(err, "{}mpmvv suite {}: {} cases ({} here, {} kept from an earlier run), {} at once, {} threads each -> {}\n",
-               prefix, suite.file, n, queue.size() + resumed, resumed, jobs, threads, dir.string());
+    fmt::print(err, "{}mpmvv suite {}: {} cases ({} here, {} kept from an earlier run{}), {} at once, {} threads each -> {}\n",
+               prefix, suite.file, n, queue.size() + resumed + unselected, resumed,
+               unselected ? fmt::format(", {} left pending by --only", unselected) : std::string(), jobs, threads,
+               dir.string());
 
   struct sigaction action {};
   action.sa_handler = on_interrupt;
@@ -860,7 +874,10 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
       const std::string error = fs::exists(results_of(i)) ? headline_error(results_of(i)) : "";
       table += fmt::format("{:<48} {:<10} {:>9.3g}  {}\n", suite.cases[i].id, case_status, wall,
                            detail.empty() ? error : detail + (error.empty() ? "" : "; " + error));
-      if (case_status != "completed" && case_status != "failed") status = 1;
+      // A case --only left out may stay pending.
+      if (case_status != "completed" && case_status != "failed" &&
+          !(case_status == "pending" && !selected(suite.cases[i])))
+        status = 1;
     }
     std::string totals;
     for (const auto& [k, v] : counts) totals += fmt::format("{}{} {}", totals.empty() ? "" : ", ", v, k);

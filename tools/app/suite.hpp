@@ -40,6 +40,7 @@ struct SuiteRequest {
   int jobs = 1;              // cases at once (per MPI rank)
   bool quiet = false;
   bool list = false;         // check the suite and print its cases; run nothing
+  std::string only;          // a regular expression: run (or list) only the cases whose id it finds; "" all
 };
 
 // Whether a results file written with configuration `stored` is the run that
@@ -51,8 +52,9 @@ struct SuiteRequest {
 bool same_configuration(const std::string& stored, const std::string& wanted, const std::string& defaults,
                         std::vector<std::string>* added = nullptr);
 
-// Exit status: 0 every case completed or was stopped by the solver (both are
-// results); 1 a case crashed, timed out or was refused; 2 bad input; 130
+// Exit status: 0 every case (every case --only selects) completed or was
+// stopped by the solver (both are results); 1 a case crashed, timed out or was
+// refused; 2 bad input; 130
 // interrupted (rerun to resume).
 int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err);
 

@@ -54,6 +54,10 @@ int main(int argc, char** argv) {
   suite_cmd->add_option("-o,--output", suite.output_dir, "output directory; default results/<suite name>")->type_name("DIR");
   suite_cmd->add_flag("-q,--quiet", suite.quiet, "no progress");
   suite_cmd->add_flag("--list", suite.list, "check the suite and list its cases with their settings; run nothing");
+  suite_cmd->add_option("--only", suite.only,
+                        "run (or list) only the cases whose id this regular expression finds, e.g. 'cells=(300|600)-'; "
+                        "the others stay as an earlier run left them (pending, or kept)")
+      ->type_name("REGEX");
 
   std::string report_dir, report_out;
   CLI::App* report_cmd = app.add_subcommand(
