@@ -721,8 +721,8 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
 
   const int cores = std::max(1u, std::thread::hardware_concurrency());
   const int jobs = std::max(1, request.jobs);
-  const int threads = std::max(1, cores / (jobs * ranks));
-  const bool passive = jobs * ranks > 1;
+  const int threads = request.threads > 0 ? request.threads : std::max(1, cores / (jobs * ranks));
+  const bool passive = jobs * ranks > 1 || request.threads > 0;  // threads set: others share the cores
   const std::string exe = self_executable();
   const bool tty = isatty(fileno(stderr));
   const std::string prefix = ranks > 1 ? fmt::format("[rank {}] ", rank) : "";

@@ -38,6 +38,7 @@ struct SuiteRequest {
   std::string suite_file;
   std::string output_dir;    // default: results/<suite name>
   int jobs = 1;              // cases at once (per MPI rank)
+  int threads = 0;           // OpenMP threads per case; 0: the cores shared out over jobs and ranks
   bool quiet = false;
   bool list = false;         // check the suite and print its cases; run nothing
   std::string only;          // a regular expression: run (or list) only the cases whose id it finds; "" all

@@ -51,6 +51,10 @@ int main(int argc, char** argv) {
                "or was refused, 2 bad input, 130 interrupted (rerun to resume).");
   suite_cmd->add_option("suite", suite.suite_file, "suite file (TOML), e.g. suites/ring-quick.toml")->required();
   suite_cmd->add_option("-j,--jobs", suite.jobs, "cases at once (per MPI rank)")->check(CLI::Range(1, 1024));
+  suite_cmd->add_option("-t,--threads", suite.threads,
+                        "OpenMP threads per case (default: the cores shared out over the cases at once, at least 1); "
+                        "set it when two suites share the machine")
+      ->check(CLI::Range(1, 1024));
   suite_cmd->add_option("-o,--output", suite.output_dir, "output directory; default results/<suite name>")->type_name("DIR");
   suite_cmd->add_flag("-q,--quiet", suite.quiet, "no progress");
   suite_cmd->add_flag("--list", suite.list, "check the suite and list its cases with their settings; run nothing");
