@@ -14,6 +14,9 @@
 #include <sstream>
 #include <string>
 
+#include <thread>
+
+#include "solver/io/hdf5.hpp"
 #include "tools/app/config.hpp"
 #include "tools/app/suite.hpp"
 
@@ -194,6 +197,23 @@ TEST(SuiteRunner, OnlyRunsTheSelectedCases) {
   EXPECT_EQ(count(manifest, "\"status\": \"completed\""), 3) << manifest;
   EXPECT_EQ(count(manifest, "kept from an earlier run"), 2) << manifest;
   EXPECT_EQ(shell(run + " --only '('"), 2);
+}
+
+// --threads sets every case's OpenMP threads (two suites sharing the
+// machine); without it the cores are shared out over the cases at once.
+TEST(SuiteRunner, ThreadsSetsEachCasesThreads) {
+  const fs::path dir = scratch("threads");
+  const fs::path suite = write(dir / "s.toml", small_suite());
+  auto threads_of = [&](const std::string& options, const std::string& out) {
+    EXPECT_EQ(shell(std::string(MPMVV_BINARY) + " suite " + suite.string() + " -q --only 'cells=8$' " + options + " -o " +
+                    (dir / out).string()),
+              0);
+    const mpmvv::h5::File file = mpmvv::h5::File::open_read((dir / out / "cases/square-cells=8.h5").string());
+    return file.root().attribute_int("threads");
+  };
+  EXPECT_EQ(threads_of("-j 1 -t 1", "one"), 1);
+  EXPECT_EQ(threads_of("-j 1", "all"), std::int64_t(std::max(1u, std::thread::hardware_concurrency())));
+  EXPECT_NE(shell(std::string(MPMVV_BINARY) + " suite " + suite.string() + " -q -t 0 -o " + (dir / "zero").string()), 0);
 }
 
 // Results written before a key existed are kept when that key is at its
