@@ -192,7 +192,7 @@ def work_precision(panels, title, y_label):
 
 def stability_map(panels, title, column_label):
     colour_map = plt.get_cmap("RdYlGn")
-    width = max(len(p.columns) for p in panels) * 0.95 + 1.6
+    width = max(len(p.columns) for p in panels) * 1.05 + 1.6
     height = max(len(p.rows) for p in panels) * 0.62 + 1.0
     figure, axes_list = _panel_grid(len(panels), width=width, height=height, columns_max=2)
     for axes, panel in zip(axes_list, panels):
@@ -217,7 +217,9 @@ def stability_map(panels, title, column_label):
         for spine in axes.spines.values():
             spine.set_visible(False)
     scale = plt.cm.ScalarMappable(norm=matplotlib.colors.Normalize(0, 1), cmap=colour_map)
-    figure.colorbar(scale, ax=axes_list, label="fraction of end time reached", shrink=0.8)
+    # A tall map (many rows) keeps a colour bar of a readable length, not its height.
+    figure.colorbar(scale, ax=axes_list, label="fraction of end time reached",
+                    shrink=min(0.8, 5.0 / figure.get_figheight()), aspect=15)
     _suptitle(figure, title)
     return figure
 

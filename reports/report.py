@@ -302,9 +302,9 @@ def stability_cell(case):
         return figures.StabilityCell(float("nan"), case.status, stopped=True)
     reached = case.time_reached
     if case.completed:
-        return figures.StabilityCell(1.0, f"{reached:.3g} s\ncompleted")
+        return figures.StabilityCell(1.0, "done")
     fraction = reached / case.end_time if case.end_time > 0 else float("nan")
-    reason = textwrap.fill(case.failure_reason or case.status, 14)
+    reason = textwrap.fill(case.failure_reason or case.status, 9)
     return figures.StabilityCell(min(max(fraction, 0.0), 1.0), f"{reached:.3g} s\n{reason}", stopped=True)
 
 
@@ -325,7 +325,7 @@ def stability_figure(study, all_series, directory):
     path = directory / f"{slug(study, 'stability')}.png"
     figures.save_png(figure, path)
     return FigureEntry(study, path, f"{study}: how far each case got (cf. table 3.2 of 000_1dbcb8acb6dddab9.txt): "
-                                    f"time reached and failure reason; hatched: stopped before the end time; "
+                                    f"time reached and failure reason (done: reached the end time); hatched: stopped before the end time; "
                                     f"grey: no results (status shown).")
 
 
