@@ -33,6 +33,7 @@ import figures
 import gate
 import norms
 import orders
+import references
 from results import (SuiteDirectoryError, lookup_error, read_contact_pressure, read_error_spectrum, read_monitors,
                      read_point_history, read_probe_lines, read_scene_history, read_suite, relative_energy_created)
 from series import DEFAULT_REFINE_KEY, refinement_series, series_levels, usable
@@ -733,6 +734,36 @@ def measurement_sections(suite):
     return sections
 
 
+def reference_sections(suite, rows):
+    """One section per [[reference]] table: the published numbers beside this suite's
+    (reports/references.py)."""
+    try:
+        tables = references.read_references(suite.references)
+    except references.ReferenceError as error:
+        return [("Against published results", f"Not shown: {error}", None)]
+    sections = []
+    for reference in tables:
+        if reference.quantity == "time_reached":
+            headers, cells, css = references.time_reached_table(suite, reference)
+            text = (f"Time reached [s] in {reference.source}, beside the time each case of this suite reached "
+                    "(with the reason when it stopped before its end time; pending: not run yet).")
+            sections.append(("Against published results: time reached", text, Table(headers, cells, css)))
+        else:
+            def unit_of(study):
+                return norms.norm_unit(reference.norm, line_quantities(suite.cases_of(study)))
+            matched = references.order_rows(suite, reference, lambda study: study_series(suite, study), order_row,
+                                            unit_of)
+            body = [[str(v) for v in values] + [f"{published:g}", f"{row.study}: {row.series.label}"]
+                    + order_cells(row)[3:] for values, published, row in matched]
+            headers = list(reference.columns) + ["reference order", "series", "t [s]", "levels", "finest error",
+                                                 "pairwise orders", "least-squares order [95% CI]", "class"]
+            text = (f"Observed order of {reference.norm} in {reference.source}, beside the order of each refinement "
+                    "series of this suite whose cases match the row (definitions under Observed orders).")
+            sections.append((f"Against published results: observed order of {reference.norm}", text,
+                             Table(headers, body, [r.classification.split()[0] for _, _, r in matched])))
+    return sections
+
+
 def order_cells(row):
     fit = row.fit
     ci = f" [{fit.ci_low:.2f}, {fit.ci_high:.2f}]" if math.isfinite(fit.ci_low) else ""
@@ -849,6 +880,7 @@ def build_report(suite, figure_directory):
             sections.append(("Expectations", f"As checked by mpmvv gate: {summary}.", expectation_table(verdicts)))
         except SuiteDirectoryError as error:
             sections.append(("Expectations", f"Not checked: {error}", None))
+    sections += reference_sections(suite, rows)
     sections += measurement_sections(suite)
     fitted = [r for r in rows if len(r.levels) >= 2]
     sections.append(("Observed orders", DEFINITIONS + f" {len(rows) - len(fitted)} of {len(rows)} (series, norm, "

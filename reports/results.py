@@ -2,7 +2,7 @@
 the results files in it (reports/results-format.md).
 
     DIR/manifest.json        every case: id, study, resolved keys, status, results path
-    DIR/suite.toml           the suite as run: [[study]] and [[expect]] tables
+    DIR/suite.toml           the suite as run: [[study]], [[expect]] and [[reference]] tables
     DIR/cases/<id>.h5        one results file per case that ran
 
 A case's status is the manifest's (completed, failed, crashed, timeout, error,
@@ -95,6 +95,7 @@ class Suite:
     has_suite_file: bool
     studies: list = field(default_factory=list)        # [[study]] tables of suite.toml
     expectations: list = field(default_factory=list)   # [[expect]] tables of suite.toml
+    references: list = field(default_factory=list)     # [[reference]] tables of suite.toml (references.py)
     cases: list = field(default_factory=list)
 
     def study_names(self):
@@ -116,9 +117,10 @@ def read_suite(directory):
     suite_file = _read_suite_file(suite_path) if suite_path.is_file() else {}
     studies = suite_file.get("study", [])
     expectations = suite_file.get("expect", [])
-    if not isinstance(studies, list) or not isinstance(expectations, list):
-        raise SuiteDirectoryError(f"{suite_path}: 'study' and 'expect' must be arrays of tables "
-                                  "([[study]], [[expect]])")
+    references = suite_file.get("reference", [])
+    if not all(isinstance(tables, list) for tables in (studies, expectations, references)):
+        raise SuiteDirectoryError(f"{suite_path}: 'study', 'expect' and 'reference' must be arrays of tables "
+                                  "([[study]], [[expect]], [[reference]])")
     return Suite(
         directory=directory,
         name=str(manifest.get("suite", directory.name)),
@@ -127,6 +129,7 @@ def read_suite(directory):
         has_suite_file=suite_path.is_file(),
         studies=studies,
         expectations=expectations,
+        references=references,
         cases=[_read_case(directory, entry) for entry in manifest["cases"]],
     )
 

@@ -201,3 +201,54 @@ def test_measurements_table_lists_every_attribute_per_case(tmp_path):
     page = written["html"].read_text()
     assert "<h2>Measurements: mesh</h2>" in page and f"<td>{hertz_load(100):.4g}</td>" in page
     assert report.measurement_text(0.015854621348) == "0.01585" and report.measurement_text(2.2454e7) == "2.245e+07"
+
+
+REFERENCE_TABLES = """
+[[reference]]
+source = "another code, table 9"
+study = "ring"
+quantity = "time_reached"
+columns = ["cells", "amplitude"]
+rows = [[32, 0.5, 0.47], [64, 0.5, 0.34], [256, 0.5, 1.0]]
+
+[[reference]]
+source = "another code, figure 9"
+study = ["ring"]
+quantity = "order"
+norm = "L1_theta0"
+time = 1.0
+columns = ["amplitude"]
+rows = [[0.5, 1.25]]
+"""
+
+
+def test_published_results_stand_beside_the_suites_own(tmp_path):
+    """Requirement: a [[reference]] time_reached table puts, for each published row,
+    the time each matching case reached (and why it stopped) beside the published
+    time, one column per method; an order table puts every matching series' observed
+    order beside the published one; the gate ignores both."""
+    directory = write_suite_directory(tmp_path / "suite", SYNTHETIC_SUITE + REFERENCE_TABLES, synthetic_ring_cases())
+    written = render(directory, tmp_path / "out")[0]
+    markdown = written["markdown"].read_text()
+    assert "## Against published results: time reached" in markdown and "another code, table 9" in markdown
+    assert "| cells | amplitude | reference [s] | ring method=linear | ring method=cpdi |" in markdown
+    assert "| 32 | 0.5 | 0.47 | 1 | 1 |" in markdown
+    assert "| 64 | 0.5 | 0.34 | 0.3 non-positive J | 1 |" in markdown
+    assert "| 256 | 0.5 | 1 | 1 | pending |" in markdown
+    assert "## Against published results: observed order of L1_theta0" in markdown
+    rows = [line for line in markdown.splitlines() if line.startswith("| 0.5 | 1.25 | ring: ")]
+    assert len(rows) == 2
+    cpdi = next(line for line in rows if "method=cpdi" in line)
+    assert "| 32, 64, 128 |" in cpdi and "2.000" in cpdi and "asymptotic" in cpdi
+    linear = next(line for line in rows if "method=linear" in line)
+    assert "| 32, 256 |" in linear and "1.000" in linear
+    assert gate.main([str(directory)]) == 0
+
+
+def test_a_reference_the_report_cannot_read_is_said_not_fatal(tmp_path):
+    """Requirement: a hand-made suite.toml whose [[reference]] is malformed still gives a
+    report, which says why the comparison is not shown."""
+    bad = SYNTHETIC_SUITE + '\n[[reference]]\nsource = "x"\nstudy = "ring"\nquantity = "speed"\nrows = [[1.0]]\n'
+    directory = write_suite_directory(tmp_path / "suite", bad, synthetic_ring_cases())
+    page = render(directory, tmp_path / "out")[0]["html"].read_text()
+    assert "Not shown: [[reference]] 1: needs &#x27;study&#x27; and &#x27;quantity&#x27;" in page

@@ -125,6 +125,27 @@ TEST(SuiteFile, MistakesNameFileLineAndKey) {
                "levels = [32, 128]\n",
        "study 'a' has no case with cells = 128"},
       {study + "set = { inner_radius = 1.3 }\n", "key 'outer_radius': must exceed inner_radius = 1.3 (from"},
+      {study + "sweep = { cells = [32, 64] }\n[[reference]]\nsource = \"x\"\nstudy = \"a\"\nquantity = \"time_reached\"\n"
+               "columns = [\"cells\"]\nrows = [[32, 0.4], [128, 0.3]]\n",
+       "s.toml:10: [[reference]]: the row cells=128 matches no case of study 'a'"},
+      {study + "sweep = { cells = [32, 64] }\n[[reference]]\nsource = \"x\"\nstudy = \"a\"\nquantity = \"time_reached\"\n"
+               "columns = [\"cels\"]\nrows = [[32, 0.4]]\n",
+       "s.toml:9: [[reference]]: column 'cels' is not a key of study 'a'"},
+      {study + "[[reference]]\nsource = \"x\"\nstudy = \"a\"\nquantity = \"speed\"\nrows = [[0.4]]\n",
+       "s.toml:7: [[reference]] needs 'quantity': \"time_reached\" or \"order\""},
+      {study + "[[reference]]\nsource = \"x\"\nstudy = [\"a\", \"b\"]\nquantity = \"order\"\nnorm = \"L1_theta0\"\nrows = [[2.0]]\n",
+       "s.toml:6: [[reference]]: no study named 'b'"},
+      {study + "[[reference]]\nsource = \"x\"\nstudy = \"a\"\nquantity = \"order\"\nrows = [[2.0]]\n",
+       "s.toml:4: [[reference]]: an order needs 'norm'"},
+      {study + "[[reference]]\nsource = \"x\"\nstudy = \"a\"\nquantity = \"time_reached\"\ncolumns = [\"cells\"]\n"
+               "rows = [[64]]\n",
+       "each row holds a value for each of the 1 columns, then the time_reached"},
+      {study + "[[reference]]\nstudy = \"a\"\nquantity = \"time_reached\"\nrows = [[-1.0]]\n",
+       "s.toml:4: [[reference]] needs a source"},
+      {study + "[[reference]]\nsource = \"x\"\nstudy = \"a\"\nquantity = \"time_reached\"\nrows = [[-1.0]]\n",
+       "the last value of a row is the time_reached, a non-negative number"},
+      {study + "[[reference]]\nsource = \"x\"\nstudy = \"a\"\nquantity = \"time_reached\"\nrows = [[1.0]]\nlevel = 3\n",
+       "s.toml:9: unknown key 'level' in [[reference]]"},
       {"[[study]]\nname = \"a b\"\n", "may hold only letters, digits"},
       {"[[study]\n", "TOML syntax error"},
   };
@@ -132,6 +153,25 @@ TEST(SuiteFile, MistakesNameFileLineAndKey) {
     const std::string message = config_error(write(dir / "s.toml", c.text));
     EXPECT_NE(message.find(c.mentions), std::string::npos) << "message: " << message << "\nexpected: " << c.mentions;
   }
+}
+
+// Published numbers beside the suite's own: the shipped Sandia suite's
+// [[reference]] tables (table 3.2 and the order of figure 3.5 of
+// 000_1dbcb8acb6dddab9.txt) load, every row matching its cases; the same row
+// with an amplitude the study does not sweep is refused.
+TEST(SuiteFile, ReferencesMatchTheirCases) {
+  const std::string sandia = std::string(MPMVV_SOURCE_DIR) + "/suites/ring-sandia.toml";
+  EXPECT_EQ(config_error(sandia), "(no error)");
+  std::string text = read(sandia);
+  const std::string row = "[300, 2, 1.0, 0.47]";
+  ASSERT_NE(text.find(row), std::string::npos);
+  text.replace(text.find(row), row.size(), "[300, 2, 0.75, 0.47]");
+  const fs::path dir = scratch("references");
+  fs::copy(std::string(MPMVV_SOURCE_DIR) + "/suites/scenes", dir / "scenes");
+  const std::string message = config_error(write(dir / "ring-sandia.toml", text));
+  EXPECT_NE(message.find("[[reference]]: the row cells=300, particles_per_direction=2, amplitude=0.75 matches no case of its studies"),
+            std::string::npos)
+      << message;
 }
 
 // A case that crashes or hangs fails alone: the others complete, the manifest
