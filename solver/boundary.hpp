@@ -143,6 +143,12 @@ struct SceneStages {
   // [0, second_body) are the first, [second_body, n) the second, each with its
   // own grid velocity field (contact.hpp). 0: one body.
   std::size_t second_body = 0;
+  // Two materials in one body (soft against stiff, PROBLEMS.md section 6):
+  // particles [0, second_material_from) take the run's material,
+  // [second_material_from, n) this one, a model of the same kind with its own
+  // constants. Absent: one material.
+  std::optional<MaterialModel> second_material;
+  std::size_t second_material_from = 0;
 };
 
 }  // namespace mpmvv

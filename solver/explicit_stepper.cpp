@@ -1,8 +1,10 @@
 #include "explicit_stepper.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -45,7 +47,8 @@ namespace {
 template <class Shape, class Material>
 class ExplicitStepper final : public Stepper {
  public:
-  ExplicitStepper(Model model, Scheme scheme, Material material, SceneStages stages, double gradient_scale,
+  ExplicitStepper(Model model, Scheme scheme, Material material, std::optional<Material> second_material,
+                  SceneStages stages, double gradient_scale,
                   Dilatation dilatation, double split_length, double viscosity_linear, double viscosity_quadratic)
       : Stepper(std::move(model)),
         scheme_(scheme),
@@ -55,6 +58,8 @@ class ExplicitStepper final : public Stepper {
         viscosity_linear_(viscosity_linear),
         viscosity_quadratic_(viscosity_quadratic),
         material_(material),
+        second_material_(std::move(second_material)),
+        second_material_from_(stages.second_material_from),
         body_force_(std::move(stages.body_force)),
         constraints_(std::move(stages.constraints)),
         damping_(stages.damping),
@@ -99,13 +104,23 @@ class ExplicitStepper final : public Stepper {
   // last step, and central differences are stable to dt = (2 / omega)
   // (sqrt(1 + xi^2) - xi): the signal speed grows by sqrt(1 + xi^2) + xi.
   ParticleScan scan() const override {
-    ParticleScan s = scan_particles(bind(model_.particles), material_, model_.particles, model_.grid.h);
+    const Shape shape = bind(model_.particles);
+    ParticleScan s;
+    s.first_unhealthy = model_.particles.size();
+    for_each_material([&](const Material& m, std::size_t begin, std::size_t end) {
+      s = combined(s, scan_particles(shape, m, model_.particles, model_.grid.h, begin, end));
+    });
     if (viscous()) s.max_signal_speed *= std::sqrt(1.0 + viscous_ratio_ * viscous_ratio_) + viscous_ratio_;
     return s;
   }
 
   Monitors monitors() const override {
-    return monitor_particles(bind(model_.particles), material_, model_.particles, model_.grid);
+    const Shape shape = bind(model_.particles);
+    Monitors m;
+    for_each_material([&](const Material& material, std::size_t begin, std::size_t end) {
+      m = combined(m, monitor_particles(shape, material, model_.particles, model_.grid, begin, end));
+    });
+    return m;
   }
 
   // Power iteration on A u = M^-1 K u over grid displacements u, where K u is
@@ -154,7 +169,9 @@ class ExplicitStepper final : public Stepper {
       moved.deformation_gradient = P.deformation_gradient;
       if constexpr (Shape::geometry == Geometry::axisymmetric) moved.hoop_stretch = P.hoop_stretch;
       grid_to_particles<kPosition | kDeformation, Shape>(bind(P), perturbed, moved, 1.0, 0.0);
-      update_stress<Shape::geometry>(material_, moved);
+      for_each_material([&](const Material& m, std::size_t begin, std::size_t end) {
+        update_stress<Shape::geometry>(m, moved, begin, end);
+      });
       particles_to_grid<kInternalForce>(bind(moved), moved, buffers, perturbed);
       double uKu = 0.0, uMu = 0.0;
       for (std::size_t i = 0; i < nodes; ++i) {
@@ -330,13 +347,28 @@ class ExplicitStepper final : public Stepper {
     if (dilatation_ == Dilatation::cell_averaged) average_cell_dilatation<Shape::geometry>(model_.grid, P, volume_sums_);
     if (dilatation_ == Dilatation::node_smoothed)
       smooth_node_dilatation(bind(P), P, volume_sums_, model_.grid.node_count());
-    update_stress<Shape::geometry>(material_, P);
+    for_each_material([&](const Material& m, std::size_t begin, std::size_t end) {
+      update_stress<Shape::geometry>(m, P, begin, end);
+    });
     if (viscous()) {
-      const ViscousStep v = add_bulk_viscosity(bind(P), P, volume_before_, material_.p_wave_modulus(), model_.grid.h,
-                                               viscosity_linear_, viscosity_quadratic_, dt);
-      ledger_.damping -= v.dissipated;
-      viscous_ratio_ = v.max_ratio;
+      viscous_ratio_ = 0.0;
+      for_each_material([&](const Material& m, std::size_t begin, std::size_t end) {
+        const ViscousStep v = add_bulk_viscosity(bind(P), P, volume_before_, m.p_wave_modulus(), model_.grid.h,
+                                                 viscosity_linear_, viscosity_quadratic_, dt, begin, end);
+        ledger_.damping -= v.dissipated;
+        viscous_ratio_ = std::max(viscous_ratio_, v.max_ratio);
+      });
     }
+  }
+
+  // Calls f(material, begin, end) for each material and the particles it
+  // holds: all of them, or [0, from) and [from, n) with a second material.
+  template <class F>
+  void for_each_material(F&& f) const {
+    const std::size_t n = model_.particles.size();
+    const std::size_t split = second_material_ ? second_material_from_ : n;
+    f(material_, 0, split);
+    if (second_material_) f(*second_material_, split, n);
   }
 
   bool viscous() const { return viscosity_linear_ > 0.0 || viscosity_quadratic_ > 0.0; }
@@ -411,6 +443,8 @@ class ExplicitStepper final : public Stepper {
   std::vector<double> volume_before_;              // with bulk viscosity: V_p before the deformation update
   std::vector<std::vector<double>> volume_sums_;  // dilatation remedies: per-thread cell or node volume sums
   Material material_;
+  std::optional<Material> second_material_;  // of particles [second_material_from_, n); absent: one material
+  std::size_t second_material_from_;
   std::shared_ptr<BodyForce> body_force_;
   std::vector<NodeConstraint> constraints_;
   double damping_;
@@ -433,7 +467,14 @@ std::unique_ptr<Stepper> make_for_shape(Model model, const SolverOptions& o, con
   return std::visit(
       [&](const auto& m) -> std::unique_ptr<Stepper> {
         using Material = std::decay_t<decltype(m)>;
-        return std::make_unique<ExplicitStepper<Shape, Material>>(std::move(model), o.scheme, m, std::move(stages),
+        std::optional<Material> second;
+        if (stages.second_material) {
+          const Material* same = std::get_if<Material>(&*stages.second_material);
+          if (!same) throw std::invalid_argument("the second material must be a model of the same kind as the first");
+          second = *same;
+        }
+        return std::make_unique<ExplicitStepper<Shape, Material>>(std::move(model), o.scheme, m, std::move(second),
+                                                                 std::move(stages),
                                                                  o.cpdi_gradient_scale, o.dilatation,
                                                                  o.split_domains_beyond * model.grid.h,
                                                                  o.bulk_viscosity_linear, o.bulk_viscosity_quadratic);
@@ -514,6 +555,12 @@ std::unique_ptr<Stepper> make_stepper(Model model, const SolverOptions& options,
     throw std::invalid_argument("the bulk viscosity coefficients must be zero (none) or positive");
   if (stages.contact && !stages.contact->displacement)
     throw std::invalid_argument("a contact master needs its displacement d(t)");
+  if (stages.second_material) {
+    if (stages.second_material_from == 0 || stages.second_material_from >= n)
+      throw std::invalid_argument("each of the two materials must hold particles: 0 < second_material_from < n");
+    if (options.split_domains_beyond > 0.0)
+      throw std::invalid_argument("split_domains_beyond serves one material only (halves are appended at the end)");
+  }
   if (stages.second_body > 0) {
     if (stages.second_body >= n) throw std::invalid_argument("the second body holds no particle");
     if (options.scheme != Scheme::usl) throw std::invalid_argument("two bodies in contact step with usl only");

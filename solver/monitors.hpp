@@ -39,18 +39,19 @@ struct Monitors {
   std::size_t near_edge = 0;   // particles whose domain reaches past the middle of the grid's outermost cell layer
 };
 
+// Over particles [begin, end) of one material (by default all).
 template <class Shape, class Material>
 Monitors monitor_particles(const Shape& shape, const Material& material, const Particles& P,
-                           const GridGeometry& grid) {
+                           const GridGeometry& grid, std::size_t begin = 0, std::size_t end = kAllParticles) {
   Monitors m;
-  const std::size_t n = P.size();
+  const std::size_t n = std::min(end, P.size());
   double kinetic = 0.0, strain = 0.0, min_J = m.min_J, max_J = 0.0, mach = 0.0;
   double distortion = 0.0;
   std::size_t near = 0;
   constexpr bool has_domain = !std::is_same_v<Shape, LinearShapeT<Shape::geometry>>;
 #pragma omp parallel for schedule(static) reduction(+ : kinetic, strain, near) reduction(min : min_J) \
     reduction(max : max_J, mach, distortion)
-  for (std::size_t p = 0; p < n; ++p) {
+  for (std::size_t p = begin; p < n; ++p) {
     const double F33 = out_of_plane_stretch<Shape::geometry>(P, p);
     const double J = determinant(P.deformation_gradient[p]) * F33;
     kinetic += 0.5 * P.mass[p] * P.velocity[p].squaredNorm();
@@ -81,6 +82,21 @@ Monitors monitor_particles(const Shape& shape, const Material& material, const P
   m.max_mach = mach;
   if constexpr (has_domain) m.max_distortion = distortion;
   m.near_edge = near;
+  return m;
+}
+
+// The monitors of a run with two materials, from those of each.
+inline Monitors combined(const Monitors& a, const Monitors& b) {
+  Monitors m;
+  m.kinetic = a.kinetic + b.kinetic;
+  m.strain = a.strain + b.strain;
+  m.min_J = std::min(a.min_J, b.min_J);
+  m.max_J = std::max(a.max_J, b.max_J);
+  m.max_mach = std::max(a.max_mach, b.max_mach);
+  m.max_distortion = std::isnan(a.max_distortion) ? b.max_distortion
+                     : std::isnan(b.max_distortion) ? a.max_distortion
+                                                    : std::max(a.max_distortion, b.max_distortion);
+  m.near_edge = a.near_edge + b.near_edge;
   return m;
 }
 

@@ -358,19 +358,23 @@ void smooth_node_dilatation(const Shape& shape, Particles& P, std::vector<std::v
 
 // ---------------------------------------------------------------- constitutive update
 
+// Particles [begin, end) of the material (a run with two materials calls it
+// once for each, SceneStages::second_material); by default every particle.
+inline constexpr std::size_t kAllParticles = std::size_t(-1);
+
 template <Geometry G, class Material>
-void update_stress(const Material& material, Particles& P) {
-  const std::size_t n = P.size();
+void update_stress(const Material& material, Particles& P, std::size_t begin = 0, std::size_t end = kAllParticles) {
+  const std::size_t n = std::min(end, P.size());
   if constexpr (G == Geometry::axisymmetric) {
 #pragma omp parallel for schedule(static)
-    for (std::size_t p = 0; p < n; ++p) {
+    for (std::size_t p = begin; p < n; ++p) {
       const Stress<double> sigma = material.stress(P.deformation_gradient[p], P.hoop_stretch[p]);
       P.stress[p] = sigma.in_plane;
       P.hoop_stress[p] = sigma.out_of_plane;
     }
   } else {
 #pragma omp parallel for schedule(static)
-    for (std::size_t p = 0; p < n; ++p) P.stress[p] = material.cauchy_stress(P.deformation_gradient[p]);
+    for (std::size_t p = begin; p < n; ++p) P.stress[p] = material.cauchy_stress(P.deformation_gradient[p]);
   }
 }
 
@@ -402,13 +406,14 @@ struct ViscousStep {
 
 template <class Shape>
 ViscousStep add_bulk_viscosity(const Shape& shape, Particles& P, const std::vector<double>& volume_before,
-                               double wave_modulus, double h, double c0, double c1, double dt) {
+                               double wave_modulus, double h, double c0, double c1, double dt, std::size_t begin = 0,
+                               std::size_t end = kAllParticles) {
   constexpr Geometry G = Shape::geometry;
   constexpr bool has_domain = !std::is_same_v<Shape, LinearShapeT<G>>;
-  const std::size_t n = P.size();
+  const std::size_t n = std::min(end, P.size());
   double dissipated = 0.0, max_ratio = 0.0;
 #pragma omp parallel for schedule(static) reduction(+ : dissipated) reduction(max : max_ratio)
-  for (std::size_t p = 0; p < n; ++p) {
+  for (std::size_t p = begin; p < n; ++p) {
     const double rate = std::log(P.volume[p] / volume_before[p]) / dt;
     if (!std::isfinite(rate)) continue;  // the health scan reports the particle
     double l = h;
@@ -551,13 +556,16 @@ double stiffening(const Shape& shape, std::size_t p, double h) {
 // to 8.0, c_p / c0_p to about 4. Without k_p the step outgrows 2 / omega_max
 // as the ring comes to rest most twisted, and finer meshes, taking more steps
 // through that stretch, blow up first.
+// Over particles [begin, end) of one material; first_unhealthy is P.size()
+// when none of them stops the run.
 template <class Shape, class Material>
-ParticleScan scan_particles(const Shape& shape, const Material& material, const Particles& P, double h) {
-  const std::size_t n = P.size();
+ParticleScan scan_particles(const Shape& shape, const Material& material, const Particles& P, double h,
+                            std::size_t begin = 0, std::size_t end = kAllParticles) {
+  const std::size_t n = std::min(end, P.size());
   double max_speed = 0.0;
-  std::size_t first = n;
+  std::size_t first = P.size();
 #pragma omp parallel for schedule(static) reduction(max : max_speed) reduction(min : first)
-  for (std::size_t p = 0; p < n; ++p) {
+  for (std::size_t p = begin; p < n; ++p) {
     if (!particle_healthy(shape, P, p)) {
       first = std::min(first, p);
       continue;
@@ -582,6 +590,11 @@ ParticleScan scan_particles(const Shape& shape, const Material& material, const 
     max_speed = std::max(max_speed, speed + v);
   }
   return {max_speed, first};
+}
+
+// The scan of a run with two materials: the larger speed, the first particle.
+inline ParticleScan combined(const ParticleScan& a, const ParticleScan& b) {
+  return {std::max(a.max_signal_speed, b.max_signal_speed), std::min(a.first_unhealthy, b.first_unhealthy)};
 }
 
 }  // namespace mpmvv

@@ -10,6 +10,7 @@
 #include "analytic/vibrating_bar.hpp"
 #ifdef MPMVV_HAVE_SUNDIALS
 #include "analytic/kinsol.hpp"
+#include "analytic/layered_bar.hpp"
 #endif
 
 namespace {
@@ -120,6 +121,39 @@ TEST(Kinsol, SolvesASystemAndReportsFailure) {
   EXPECT_THROW(solve_nonlinear([](const std::vector<double>& u, std::vector<double>& f) { f[0] = u[0] * u[0] + 1.0; },
                                {0.3}, 1e-12),
                SundialsError);
+}
+
+// The layered bar (soft against stiff): with equal layers its frequency is the
+// one-layer bar's pi c / 2L; with a soft second layer its first mode meets
+// the wave equation in each layer, u(0) = 0, continuity of u and of the
+// traction M u_X at the interface, and u_X(L) = 0; the frequency is the
+// first root (nothing below it changes sign).
+TEST(LayeredBar, FirstModeMeetsTheInterfaceAndEndConditions) {
+  const double M = 2.79e11, rho = 7850.0;
+  const LayeredBar equal{0.5, 0.5, M, M, rho, rho};
+  EXPECT_NEAR(equal.first_frequency() / (pi * std::sqrt(M / rho) / 2.0), 1.0, 1e-13);
+  for (const double ratio : {0.1, 1e-2, 1e-4, 30.0}) {
+    const LayeredBar bar{0.4, 0.6, M, ratio * M, rho, rho};
+    const double omega = bar.first_frequency();
+    EXPECT_LT(std::abs(bar.frequency_residual(omega)), 1e-13) << ratio;
+    for (int k = 1; k < 1000; ++k) EXPECT_LT(bar.frequency_residual(omega * k / 1000.0), 0.0) << ratio;
+    const LayeredBarMotion motion{bar, omega, 1.0};
+    const double d = 1e-6, L1 = bar.length_1, L = bar.length();
+    auto slope = [&](double a, double b) { return (motion.mode(b) - motion.mode(a)) / (b - a); };
+    EXPECT_EQ(motion.mode(0.0), 0.0);
+    const double scale = std::abs(slope(L1 + d, L1 + 2 * d)) + std::abs(slope(L1 - 2 * d, L1 - d));
+    EXPECT_NEAR(motion.mode(L1 - 1e-12), motion.mode(L1), 1e-9 * std::abs(motion.mode(L1))) << ratio;
+    EXPECT_NEAR(bar.modulus_1 * slope(L1 - d, L1), bar.modulus_2 * slope(L1, L1 + d), 1e-4 * bar.modulus_1 * scale)
+        << ratio;
+    EXPECT_NEAR(slope(L - d, L), 0.0, 1e-4 * scale) << ratio;
+    // u_tt = c^2 u_XX in the second layer, where u = mode(X) sin(omega t).
+    const double X = 0.8, h = 1e-4;
+    const double u_xx = (motion.mode(X + h) - 2 * motion.mode(X) + motion.mode(X - h)) / (h * h);
+    EXPECT_NEAR(-omega * omega * motion.mode(X), bar.wave_speed_2() * bar.wave_speed_2() * u_xx,
+                1e-5 * omega * omega * std::abs(motion.mode(X)))
+        << ratio;
+  }
+  EXPECT_THROW((LayeredBar{0.5, 0.5, M, -M, rho, rho}.first_frequency()), std::invalid_argument);
 }
 
 // The neo-Hookean bar: at vanishing stretch it has the small-strain stiffness

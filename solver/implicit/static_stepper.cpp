@@ -513,6 +513,8 @@ std::unique_ptr<Stepper> make_static_stepper(Model model, const SolverOptions& o
     throw std::invalid_argument("bulk viscosity serves the explicit step only (a static step has no rate)");
   if (options.formulation != Formulation::updated)
     throw std::invalid_argument("the implicit static step has the updated formulation only");
+  if (stages.second_material)
+    throw std::invalid_argument("a second material serves the explicit step only");
   switch (options.method) {
     case Method::linear: return make_for_shape<LinearShape>(std::move(model), material, std::move(stages), o);
     case Method::gimp: return make_for_shape<GimpShapeT<Geometry::plane_strain>>(std::move(model), material, std::move(stages), o);

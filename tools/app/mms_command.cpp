@@ -123,6 +123,7 @@ int mms_check(const MmsCheckRequest& r, std::ostream& out, std::ostream& err) {
   // stay that far inside the body and off the axis.
   std::vector<mms::ResidualCheck> checks;
   std::vector<Vec2> where;
+  std::vector<double> when;
   int attempts = 0;
   while (int(checks.size()) < r.points && attempts < 1000 * r.points) {
     ++attempts;
@@ -132,13 +133,17 @@ int mms_check(const MmsCheckRequest& r, std::ostream& out, std::ostream& err) {
     for (const Vec2& d : {Vec2(margin, 0), Vec2(-margin, 0), Vec2(0, margin), Vec2(0, -margin)})
       inside = inside && setup.contains(X + d);
     if (!inside || (setup.geometry == Geometry::axisymmetric && X.x() < 0.02 * hi.x())) continue;
-    checks.push_back(setup.solution->check(X, ut(rng)));
+    when.push_back(ut(rng));
+    checks.push_back(setup.solution->check(X, when.back()));
     where.push_back(X);
   }
   double scale = 0.0, worst_global = 0.0, mean_global = 0.0, worst_local = 0.0;
+  std::size_t worst = 0;
   for (const auto& c : checks) scale = std::max(scale, c.scale);
-  for (const auto& c : checks) {
+  for (std::size_t k = 0; k < checks.size(); ++k) {
+    const mms::ResidualCheck& c = checks[k];
     const double g = c.residual.norm() / scale;
+    if (g > worst_global) worst = k;
     worst_global = std::max(worst_global, g);
     mean_global += g / double(checks.size());
     if (c.scale > 1e-3 * scale) worst_local = std::max(worst_local, c.relative());
@@ -146,8 +151,9 @@ int mms_check(const MmsCheckRequest& r, std::ostream& out, std::ostream& err) {
   const bool pass = worst_global <= r.tolerance;
   fmt::print(out, "{}: residual a - Div P / rho_0 - b at {} random points (finite differences against the derived force)\n",
              r.name, checks.size());
-  fmt::print(out, "  relative to the largest |a| + |Div P / rho_0| + |b| = {:.4g}: max {:.3e}, mean {:.3e}\n", scale,
-             worst_global, mean_global);
+  fmt::print(out, "  relative to the largest |a| + |Div P / rho_0| + |b| = {:.4g}: max {:.3e} (at X = ({:.6g}, {:.6g}), "
+             "t = {:.6g}), mean {:.3e}\n", scale, worst_global, checks.empty() ? NAN : where[worst].x(),
+             checks.empty() ? NAN : where[worst].y(), checks.empty() ? NAN : when[worst], mean_global);
   fmt::print(out, "  pointwise, where the local scale exceeds 1e-3 of it: max {:.3e}\n", worst_local);
   fmt::print(out, "  {} (tolerance {:.1e})\n", pass ? "PASS" : "FAIL", r.tolerance);
   return pass ? 0 : 1;

@@ -154,6 +154,10 @@ class MmsCase final : public SceneCase, private RunObserver {
     seed_tracers(model.tracers);
     SceneStages stages;
     if (setup_.stages) stages = setup_.stages(model.particles, model.grid);
+    if (setup_.second_material) {
+      stages.second_material = setup_.second_material;
+      stages.second_material_from = first_material_count_;
+    }
     if (!setup_.force_free) {
       stages.body_force = setup_.fast_body_force;
       if (!stages.body_force) stages.body_force = std::make_shared<mms::DerivedBodyForce>(setup_.solution);
@@ -425,6 +429,13 @@ class MmsCase final : public SceneCase, private RunObserver {
     for (int j = 0; j < grid.cells_y; ++j)
       for (int i = 0; i < grid.cells_x; ++i)
         for (const Piece& piece : pieces_of_cell(i, j, ppd)) pieces.push_back(piece);
+    // A second material's particles after the first's, each in seeding order.
+    if (setup_.second_material) {
+      const auto second = std::stable_partition(pieces.begin(), pieces.end(), [this](const Piece& piece) {
+        return !setup_.in_second_material(piece.centroid);
+      });
+      first_material_count_ = std::size_t(second - pieces.begin());
+    }
     P.resize(pieces.size());
     const bool axisymmetric = setup_.geometry == Geometry::axisymmetric;
     if (axisymmetric) {
@@ -636,6 +647,7 @@ class MmsCase final : public SceneCase, private RunObserver {
   Fault fault_ = Fault::none;
   bool exact_seeding_ = false;
   double particle_volume_ = 0.0;
+  std::size_t first_material_count_ = 0;  // with a second material: the particles of the first
   ProblemSetup setup_;
   SolverOptions options_;
   TimeLoopOptions loop_;
@@ -680,6 +692,7 @@ MmsProblem shear_problem();
 MmsProblem hertz_cylinder_problem();
 #ifdef MPMVV_HAVE_SUNDIALS
 MmsProblem neo_hookean_bar_problem();
+MmsProblem layered_bar_problem();
 #endif
 
 const std::vector<MmsProblem>& mms_problems() {
@@ -689,6 +702,7 @@ const std::vector<MmsProblem>& mms_problems() {
                                  uniaxial_compression_problem(), shear_problem(), hertz_cylinder_problem()};
 #ifdef MPMVV_HAVE_SUNDIALS
     p.push_back(neo_hookean_bar_problem());  // its exact state is a root found by KINSOL
+    p.push_back(layered_bar_problem());      // its frequency too
 #endif
     return p;
   }();

@@ -67,6 +67,11 @@ struct RunRecord {
 struct ProblemSetup {
   std::shared_ptr<const mms::ExactSolution> solution;
   MaterialModel material;
+  // A second material in the same body (soft against stiff): the particles
+  // whose reference position `in_second_material` holds take it, and are
+  // seeded after the others (SceneStages::second_material). Absent: one.
+  std::optional<MaterialModel> second_material;
+  std::function<bool(const Vec2&)> in_second_material;
   Geometry geometry = Geometry::plane_strain;
   GridGeometry grid;
   std::function<bool(const Vec2&)> contains;  // the body, in reference coordinates
