@@ -98,7 +98,7 @@ def check_expectation(number, expect, suite):
     if not cases:
         return [Verdict(number, expect, None, (), nan_fit, float("nan"),
                         (f"no case of study '{expect['study']}' matches where = {where}",), ())]
-    all_series = refinement_series(cases, refine)
+    all_series = refinement_series(cases, refine, suite.varied_keys(expect["study"]))
     if not all_series:
         return [Verdict(number, expect, None, (), nan_fit, float("nan"),
                         (f"no matched case has the refine key '{refine}'",), ())]

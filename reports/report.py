@@ -103,7 +103,7 @@ def refine_key(suite, study):
 
 
 def study_series(suite, study):
-    return refinement_series(suite.cases_of(study), refine_key(suite, study))
+    return refinement_series(suite.cases_of(study), refine_key(suite, study), suite.varied_keys(study))
 
 
 def expectation_times(suite, study):

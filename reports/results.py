@@ -105,6 +105,11 @@ class Suite:
     def cases_of(self, study):
         return [c for c in self.cases if c.study == study]
 
+    def varied_keys(self, study):
+        """The keys the study's [[study]] table sweeps and zips, in file order."""
+        table = next((s for s in self.studies if s.get("name") == study), {})
+        return [key for part in ("sweep", "zip") if isinstance(table.get(part), dict) for key in table[part]]
+
 
 def read_suite(directory):
     """Read DIR/manifest.json, DIR/suite.toml (optional here) and every case's results."""

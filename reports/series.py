@@ -70,9 +70,13 @@ def _as_float(value):
     return value
 
 
-def refinement_series(cases, refine=DEFAULT_REFINE_KEY):
+def refinement_series(cases, refine=DEFAULT_REFINE_KEY, named_first=()):
     """Split cases (of one study) into refinement series by the rule of the module docstring.
-    Cases without the refine key are left out."""
+    Cases without the refine key are left out. Keys that vary together between
+    series, one value of each with one value of the other (zipped, e.g. a
+    stiffness ratio with the end time it needs), are named in the label by one
+    of them: the first in `named_first` (the study's swept and zipped keys in file
+    order), else the first."""
     cases = [c for c in cases if refine in c.keys]
     if not cases:
         return []
@@ -82,10 +86,22 @@ def refinement_series(cases, refine=DEFAULT_REFINE_KEY):
     groups = {}
     for case in cases:
         groups.setdefault(tuple(_canonical(case.keys.get(n)) for n in grouping), []).append(case)
+    rank = {name: index for index, name in enumerate(named_first)}
+    ordered = sorted(grouping, key=lambda n: (rank.get(n, len(rank)), grouping.index(n)))
+    named = []
+    for name in ordered:
+        if not any(_one_to_one(cases, name, kept) for kept in named):
+            named.append(name)
     return [Series(study=members[0].study, refine=refine,
-                   label_keys={n: members[0].keys.get(n) for n in grouping},
+                   label_keys={n: members[0].keys.get(n) for n in grouping if n in named},
                    cases=tuple(_coarse_first(members, refine)))
             for members in groups.values()]
+
+
+def _one_to_one(cases, a, b):
+    """True when each value of key a goes with one value of key b and the reverse."""
+    pairs = {(_canonical(c.keys.get(a)), _canonical(c.keys.get(b))) for c in cases}
+    return len(pairs) == len({p[0] for p in pairs}) == len({p[1] for p in pairs})
 
 
 def _follows(cases, name, refine):

@@ -39,6 +39,21 @@ def test_a_key_that_follows_the_refine_key_does_not_split_a_series(synthetic_sui
     assert [s.label for s in refinement_series(changed)] == ["method=linear", "method=cpdi"]
 
 
+def test_zipped_keys_are_named_by_the_first_the_study_lists(synthetic_suite):
+    """Requirement: keys zipped together between series (an amplitude with the end
+    time it needs) still split the series, and the label names them by the key the
+    study sweeps or zips first; without that order, by the first in the case keys."""
+    cases = read_suite(synthetic_suite).cases_of("ring")
+    zipped = [replace(c, keys={**c.keys, "end_time": 1.0 if c.keys["method"] == "cpdi" else 2.0,
+                               "amplitude": 0.5 if c.keys["method"] == "cpdi" else 1.0}) for c in cases]
+    series = refinement_series(zipped, "cells", ["method", "cells", "amplitude", "end_time"])
+    assert [s.label for s in series] == ["method=linear", "method=cpdi"]
+    series = refinement_series(zipped, "cells", ["amplitude", "end_time"])
+    assert [s.label for s in series] == ["amplitude=1.0", "amplitude=0.5"]
+    assert [s.label for s in refinement_series(zipped, "cells", ["end_time"])] == ["end_time=2.0", "end_time=1.0"]
+    assert len(refinement_series(zipped)) == 2
+
+
 def test_series_levels_are_sorted_coarse_first_even_without_results(synthetic_suite):
     """Requirement: a case without results (pending) takes its place by its refine value."""
     cpdi = refinement_series(read_suite(synthetic_suite).cases_of("ring"))[1]
