@@ -17,6 +17,7 @@
 #pragma once
 
 #include <cmath>
+#include <numbers>
 
 #include <Eigen/Core>
 
@@ -73,7 +74,7 @@ struct LayeredBarMotion {
     return X + displacement(X, t);
   }
   double length_scale() const { return bar.length(); }
-  double time_scale() const { return 2.0 * 3.14159265358979323846 / omega; }
+  double time_scale() const { return 2.0 * std::numbers::pi / omega; }
 };
 
 }  // namespace mpmvv::analytic
