@@ -58,7 +58,8 @@ ORDERS_CSV_COLUMNS = (
     ("finest_error", "its error"),
     ("left_out", "levels without a usable value at that time, and why"),
 )
-METHOD_KEYS = ("method", "scheme", "particles_per_direction", "cfl", "time_integration", "solver", "load_steps")
+METHOD_KEYS = ("method", "scheme", "particles_per_direction", "cfl", "time_integration", "solver", "load_steps",
+               "dilatation", "formulation")
 PARAMETER_LABELS = {"reference_radius": "reference radius R [m]", "reference_r": "reference radius R [m]",
                     "reference_x": "reference X [m]", "reference_y": "reference Y [m]",
                     "reference_z": "reference Z [m]", "reference_position": "distance from the origin [m]"}

@@ -101,6 +101,19 @@ TEST(SuiteFile, ExpandsSweepZipAndOverrides) {
   EXPECT_EQ(overridden, 2);
 }
 
+// A zipped list may repeat a value when the tuples differ (the explicit step
+// with two dilatations beside the implicit one).
+TEST(SuiteFile, ZipRepeatsAValueInDistinctTuples) {
+  const fs::path dir = scratch("zip-repeat");
+  const fs::path suite = write(dir / "s.toml", "[[study]]\nname = \"r\"\nscene = \"" + kScenes + "/ring.toml\"\n"
+                                               "zip = { method = [\"cpdi\", \"cpdi\", \"gimp\"], cfl = [0.3, 0.2, 0.3] }\n");
+  const mpmvv::app::Suite s = mpmvv::app::load_suite(suite.string());
+  ASSERT_EQ(s.cases.size(), 3u);
+  EXPECT_EQ(s.cases[0].id, "r-method=cpdi-cfl=0.3");
+  EXPECT_EQ(s.cases[1].id, "r-method=cpdi-cfl=0.2");
+  EXPECT_EQ(s.cases[2].id, "r-method=gimp-cfl=0.3");
+}
+
 // Every mistake is one message naming the file, the line and the key, before
 // anything runs.
 TEST(SuiteFile, MistakesNameFileLineAndKey) {
@@ -117,6 +130,8 @@ TEST(SuiteFile, MistakesNameFileLineAndKey) {
       {study + "foo = 1\n", "s.toml:4: unknown key 'foo' in [[study]]"},
       {study + "set = { cells = 32 }\nsweep = { cells = [32, 64] }\n", "key 'cells' is given twice"},
       {study + "sweep = { cells = [32, 32] }\n", "'cells' lists 32 twice"},
+      {study + "zip = { cells = [32, 64, 32], cfl = [0.3, 0.3, 0.3] }\n",
+       "s.toml:4: zip: entries 1 and 3 are the same (cells=32, cfl=0.3)"},
       {"[[study]]\nname = \"a\"\nscene = \"nope.toml\"\n", "s.toml:3: study 'a': no such scene file"},
       {study + "[[expect]]\nstudy = \"b\"\nnorm = \"L1\"\norder = 2\ntolerance = 0.1\n", "s.toml:5: [[expect]]: no study named 'b'"},
       {study + "sweep = { cells = [32, 64] }\n[[expect]]\nstudy = \"a\"\nnorm = \"L1_theta0\"\norder = 2\n",

@@ -53,7 +53,7 @@ class StaticStepper final : public Stepper {
     }
     const SmallStrainModuli m = material_.small_strain_moduli();
     moduli_ = m;
-    force_scale_ = (m.lambda + 2.0 * m.mu) * model_.grid.h;
+    force_scale_ = 2.0 * m.mu * model_.grid.h;
   }
 
   void step(double t, double dt, double) override {
@@ -95,7 +95,7 @@ class StaticStepper final : public Stepper {
     residual_evaluations_ += result.residual_evaluations;
     ++solves_;
     if (!result.converged) {
-      failure_ = fmt::format("KINSOL: {} after {} Newton iterations (|R| / ((lambda + 2 mu) h) = {:.3g})",
+      failure_ = fmt::format("KINSOL: {} after {} Newton iterations (|R| / (2 mu h) = {:.3g})",
                              result.message, result.iterations, result.residual_norm);
       return;
     }

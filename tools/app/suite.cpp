@@ -140,6 +140,9 @@ struct Axis {
   std::string origin;
 };
 
+// A sweep list names each value once; a zip list may repeat a value when the
+// zipped tuples differ (solver = ["explicit", "explicit", "implicit"] beside
+// dilatation = ["particle", "cell-averaged", "particle"]); each tuple once.
 std::vector<Axis> axes_of(const toml::table& table, const std::string& file, const std::vector<KeySpec>& specs,
                           const std::string& scene, const std::string& what) {
   std::vector<Axis> axes;
@@ -154,9 +157,10 @@ std::vector<Axis> axes_of(const toml::table& table, const std::string& file, con
     for (const toml::node& item : *node.as_array()) {
       const std::optional<Value> v = to_value(item);
       if (!v) throw ConfigError(fmt::format("{}: {}: '{}' holds a value of an unsupported type", where_in(file, node), what, key));
-      for (const Value& seen : axis.values)
-        if (same_value(seen, *v))
-          throw ConfigError(fmt::format("{}: {}: '{}' lists {} twice", where_in(file, node), what, key, format_value(*v)));
+      if (what == "sweep")
+        for (const Value& seen : axis.values)
+          if (same_value(seen, *v))
+            throw ConfigError(fmt::format("{}: {}: '{}' lists {} twice", where_in(file, node), what, key, format_value(*v)));
       axis.values.push_back(*v);
     }
     axes.push_back(std::move(axis));
@@ -392,6 +396,14 @@ Suite load_suite(const std::string& path) {
       if (a.values.size() != zip_length)
         throw ConfigError(fmt::format("{}: zip: '{}' has {} values but '{}' has {}: zipped lists must be equally long",
                                       a.origin, a.key, a.values.size(), zip.front().key, zip_length));
+    // Every zipped tuple once: the same tuple twice would be the same case twice.
+    for (std::size_t i = 0; i < zip_length; ++i)
+      for (std::size_t j = 0; j < i; ++j)
+        if (std::all_of(zip.begin(), zip.end(), [&](const Axis& a) { return same_value(a.values[i], a.values[j]); })) {
+          std::string tuple;
+          for (const Axis& a : zip) tuple += (tuple.empty() ? "" : ", ") + a.key + "=" + format_value(a.values[i]);
+          throw ConfigError(fmt::format("{}: zip: entries {} and {} are the same ({})", zip.front().origin, j + 1, i + 1, tuple));
+        }
     // A key belongs to one of set, sweep, zip.
     std::vector<std::string> seen;
     auto claim = [&](const std::string& key, const std::string& origin) {
