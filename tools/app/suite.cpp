@@ -400,9 +400,11 @@ Suite load_suite(const std::string& path) {
     for (std::size_t i = 0; i < zip_length; ++i)
       for (std::size_t j = 0; j < i; ++j)
         if (std::all_of(zip.begin(), zip.end(), [&](const Axis& a) { return same_value(a.values[i], a.values[j]); })) {
-          std::string tuple;
-          for (const Axis& a : zip) tuple += (tuple.empty() ? "" : ", ") + a.key + "=" + format_value(a.values[i]);
-          throw ConfigError(fmt::format("{}: zip: entries {} and {} are the same ({})", zip.front().origin, j + 1, i + 1, tuple));
+          std::vector<std::string> keys;
+          std::vector<Value> values;
+          for (const Axis& a : zip) keys.push_back(a.key), values.push_back(a.values[i]);
+          throw ConfigError(fmt::format("{}: zip: entries {} and {} are the same ({})", zip.front().origin, j + 1, i + 1,
+                                        row_text(keys, values)));
         }
     // A key belongs to one of set, sweep, zip.
     std::vector<std::string> seen;
