@@ -62,16 +62,4 @@ std::shared_ptr<const ExactSolution> make_solution(const Motion& motion, const M
       material);
 }
 
-// The derived body force as the solver's body-force stage.
-class DerivedBodyForce final : public BodyForce {
- public:
-  explicit DerivedBodyForce(std::shared_ptr<const ExactSolution> solution) : solution_(std::move(solution)) {}
-  void evaluate(double t, const Particles& particles, std::vector<Vec2>& b) const override {
-    solution_->body_forces(t, particles.reference_position, b);
-  }
-
- private:
-  std::shared_ptr<const ExactSolution> solution_;
-};
-
 }  // namespace mpmvv::mms

@@ -18,6 +18,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "force_field.hpp"
 #include "solver/material/neo_hookean.hpp"
 #include "solver/model.hpp"
 #include "solver/tensor.hpp"
@@ -205,27 +206,26 @@ class RingMms {
   NeoHookean material_;
 };
 
-// The closed form as the solver's body-force stage, for the neo-Hookean ring.
-// The radial factors and the direction of each particle's reference position
-// never change, so they are kept per particle; a step then costs one
-// time-function evaluation and one sin/cos pair per particle.
-// tests/test_manufactured.cpp shows it equals the derived force to round-off.
-class RingClosedFormBodyForce final : public BodyForce {
+// The closed form as a force field (force_field.hpp), for the neo-Hookean
+// ring. The radial factors and the direction of each point never change, so
+// they are kept per point; a step then costs one time-function evaluation and
+// one sin/cos pair per point. tests/test_manufactured.cpp shows it equals the
+// derived force to round-off.
+class RingClosedFormField final : public ForceField {
  public:
-  explicit RingClosedFormBodyForce(const RingMms& mms) : mms_(mms) {}
+  explicit RingClosedFormField(const RingMms& mms) : mms_(mms) {}
 
-  void prepare(const Particles& P) override {
+  void prepare(const std::vector<Vec2>& points) override {
     radial_.clear();
     direction_.clear();
-    for (const Vec2& X : P.reference_position) {
+    for (const Vec2& X : points) {
       radial_.push_back(mms_.radial(X.norm()));
       direction_.push_back(X / X.norm());
     }
   }
 
-  void evaluate(double t, const Particles& P, std::vector<Vec2>& b) const override {
-    const std::size_t n = P.size();
-    if (n != radial_.size()) throw std::logic_error("ring body force: prepare() was not called for these particles");
+  void evaluate(double t, std::vector<Vec2>& b) const override {
+    const std::size_t n = radial_.size();
     const RingMms::Temporal q = mms_.temporal(t);
 #pragma omp parallel for schedule(static)
     for (std::size_t p = 0; p < n; ++p) b[p] = mms_.body_force(radial_[p], direction_[p].x(), direction_[p].y(), q);
@@ -234,7 +234,7 @@ class RingClosedFormBodyForce final : public BodyForce {
  private:
   RingMms mms_;
   std::vector<RingMms::Radial> radial_;
-  std::vector<Vec2> direction_;  // X_p / |X_p|: (cos Theta_p, sin Theta_p)
+  std::vector<Vec2> direction_;  // X / |X|: (cos Theta, sin Theta)
 };
 
 }  // namespace mpmvv::mms

@@ -18,13 +18,23 @@ weighted by the reference volume V_p0 of each particle:
     particle_L2   = sqrt(sum_p V_p0 e_p^2 / sum_p V_p0)
     particle_Linf = max_p e_p
 
+and, over the run so far, the time-integrated relative L2 error (the norm the
+total Lagrangian MPM literature reports for the ring, its "vortex"):
+
+    particle_relative_L2_integrated
+        = sqrt( int_0^t sum_p V_p0 e_p^2 dt / int_0^t sum_p V_p0 |x_exact - X_p|^2 dt )
+
+(trapezoid rule over t = 0 and the output times; exact_displacement_L2 is the
+RMS of |x_exact - X_p| at each output time).
+
 They need the exact motion at every particle, which only the solver evaluates,
 so the report reads them from /errors; ``volume_weighted_norms`` states the
 same definitions as code (and is tested on arrays whose norms are known).
 """
 import numpy as np
 
-PARTICLE_NORMS = ("particle_L1", "particle_L2", "particle_Linf")
+PARTICLE_NORMS = ("particle_L1", "particle_L2", "particle_Linf", "exact_displacement_L2")
+RELATIVE_NORMS = ("particle_relative_L2_integrated",)
 
 QUANTITY_UNITS = {
     "angular_displacement": "rad",
@@ -79,6 +89,8 @@ def norm_unit(norm, line_quantities):
     """Unit of an /errors column: m for particle norms, the line's quantity unit for L1_<line>."""
     if norm in PARTICLE_NORMS:
         return "m"
+    if norm in RELATIVE_NORMS:
+        return "1"
     quantity = line_quantities.get(norm[len("L1_"):]) if norm.startswith("L1_") else None
     return QUANTITY_UNITS.get(quantity, "")
 
@@ -91,6 +103,10 @@ def describe_norm(norm, line_quantities):
         return "volume-weighted RMS particle displacement error"
     if norm == "particle_Linf":
         return "largest particle displacement error"
+    if norm == "exact_displacement_L2":
+        return "volume-weighted RMS exact displacement (the scale of the particle errors)"
+    if norm == "particle_relative_L2_integrated":
+        return "time-integrated relative L2 particle displacement error, from t = 0"
     if norm.startswith("L1_"):
         line = norm[len("L1_"):]
         quantity = QUANTITY_LABELS.get(line_quantities.get(line), "probe quantity")

@@ -10,6 +10,10 @@ A reference names one or more studies, the scene keys that identify a row
   each matching case's time reached and, when it stopped early, why. Cases of a
   study that match one row are told apart by the study's other varying keys
   (e.g. method), each such group a column.
+* quantity = "error": the error the other code reached, in the norm `norm`
+  (an /errors column) at output time `time` (default: each case's end time).
+  Beside it, each matching case's error in the same norm at the same time,
+  grouped into columns as for time_reached.
 * quantity = "order": the observed order the other code reported for `norm` at
   output time `time`. Beside it, each refinement series of the named studies
   whose cases all match the row: its usable levels, pairwise orders and
@@ -25,11 +29,11 @@ from series import _canonical
 class Reference:
     source: str
     studies: tuple
-    quantity: str                # "time_reached" or "order"
+    quantity: str                # "time_reached", "error" or "order"
     columns: tuple               # scene keys that identify a row
     rows: tuple                  # (key values tuple, published number)
     norm: str = ""
-    time: float = float("nan")   # order only; NaN: each series' end time
+    time: float = float("nan")   # error and order; NaN: each case's (series') end time
 
 
 class ReferenceError(ValueError):
@@ -49,8 +53,8 @@ def read_references(tables):
         studies = (studies,) if isinstance(studies, str) else tuple(studies or ())
         quantity = table.get("quantity")
         columns = tuple(table.get("columns", ()))
-        if not studies or quantity not in ("time_reached", "order"):
-            raise ReferenceError(f"{where}: needs 'study' and 'quantity' (time_reached or order)")
+        if not studies or quantity not in ("time_reached", "error", "order"):
+            raise ReferenceError(f"{where}: needs 'study' and 'quantity' (time_reached, error or order)")
         rows = []
         for row in table.get("rows", ()):
             if not isinstance(row, list) or len(row) != len(columns) + 1:
@@ -88,8 +92,10 @@ def reached_text(case):
     return reached if case.completed else f"{reached} {case.failure_reason or case.status}"
 
 
-def time_reached_table(suite, reference):
-    """(headers, rows, css): one row per published row; a column per (study, group)."""
+def case_table(suite, reference, cell_of, published_header):
+    """(headers, rows, css): one row per published row, with its published number
+    and a column per (study, group of the study's other varying keys) holding
+    cell_of(case) for the case that matches the row, or "-"."""
     groups = []                  # (study, group key values, label)
     for study in reference.studies:
         cases = suite.cases_of(study)
@@ -99,21 +105,35 @@ def time_reached_table(suite, reference):
             label = study + "".join(f" {n}={case.keys.get(n)}" for n in varying)
             if (study, values, label) not in groups:
                 groups.append((study, values, label))
-    headers = list(reference.columns) + ["reference [s]"] + [label for _, _, label in groups]
+    headers = list(reference.columns) + [published_header] + [label for _, _, label in groups]
     rows, css = [], []
     for values, published in reference.rows:
         cells = [str(v) for v in values] + [f"{published:g}"]
-        row_cases = []
         for study, group, _ in groups:
             cases = suite.cases_of(study)
             varying = group_keys(cases, reference.columns)
             match = [c for c in cases if row_matches(c.keys, reference.columns, values)
                      and tuple(_canonical(c.keys.get(n)) for n in varying) == group]
-            row_cases.append(match[0] if match else None)
-        cells += [reached_text(c) for c in row_cases]
+            cells.append(cell_of(match[0]) if match else "-")
         rows.append(cells)
         css.append("")
     return headers, rows, css
+
+
+def time_reached_table(suite, reference):
+    """(headers, rows, css): the published time and each matching case's time reached."""
+    return case_table(suite, reference, reached_text, "reference [s]")
+
+
+def error_table(suite, reference, lookup_error, unit):
+    """(headers, rows, css): the published error and each matching case's error in
+    the same norm at the reference's time (each case's end time when it names none),
+    or why there is none. lookup_error(case, norm, time) is results.lookup_error."""
+    def cell(case):
+        time = reference.time if math.isfinite(reference.time) else case.end_time
+        value, why = lookup_error(case, reference.norm, time)
+        return f"{value:.3g}" if math.isfinite(value) else why
+    return case_table(suite, reference, cell, f"reference [{unit}]")
 
 
 def order_rows(suite, reference, series_of, order_row, unit_of):

@@ -236,7 +236,8 @@ def series_styles(all_series):
 
 def figure_norms(suite, study, cases):
     """(norm, time or None for the end time) pairs drawn against h: those the study's
-    expectations name, the first probe line's L1 and particle_L2 at the end time
+    expectations name, the first probe line's L1, particle_L2 and the time-integrated
+    relative L2 at the end time
     (an expectation's time equal to the study's one end time counts as the end time)."""
     ends = {c.end_time for c in cases if math.isfinite(c.end_time)}
     pairs = []
@@ -247,6 +248,7 @@ def figure_norms(suite, study, cases):
             pairs.append((e["norm"], float(time) if explicit else None))
     first_line = next(iter(line_quantities(cases)), None)
     pairs += [(f"L1_{first_line}", None), ("particle_L2", None)] if first_line else [("particle_L2", None)]
+    pairs.append(("particle_relative_L2_integrated", None))
     columns = error_columns(cases)
     return [p for p in dict.fromkeys(pairs) if p[0] in columns]
 
@@ -749,6 +751,14 @@ def reference_sections(suite, rows):
             text = (f"Time reached [s] in {reference.source}, beside the time each case of this suite reached "
                     "(with the reason when it stopped before its end time; pending: not run yet).")
             sections.append(("Against published results: time reached", text, Table(headers, cells, css)))
+        elif reference.quantity == "error":
+            quantities = line_quantities(suite.cases_of(reference.studies[0]))
+            unit = norms.norm_unit(reference.norm, quantities)
+            time = f"t = {reference.time:g} s" if math.isfinite(reference.time) else "the end time"
+            headers, cells, css = references.error_table(suite, reference, lookup_error, unit)
+            text = (f"{reference.norm} ({norms.describe_norm(reference.norm, quantities)}) at {time} in {reference.source}, "
+                    "beside the same norm of each case of this suite that matches the row.")
+            sections.append((f"Against published results: {reference.norm}", text, Table(headers, cells, css)))
         else:
             def unit_of(study):
                 return norms.norm_unit(reference.norm, line_quantities(suite.cases_of(study)))
@@ -862,7 +872,8 @@ def status_counts(suite):
 DEFINITIONS = (
     "Norms: L1_<line> is eq. 3.1 of 000_1dbcb8acb6dddab9.txt, the mean over a probe line's material points of "
     "|q_sim - q_exact|; particle_L1, particle_L2 and particle_Linf are the reference-volume-weighted mean, RMS and "
-    "maximum of the particle displacement error |x_p - x_exact(X_p, t)| (reports/norms.py). Orders: pairwise "
+    "maximum of the particle displacement error |x_p - x_exact(X_p, t)|; particle_relative_L2_integrated is "
+    "sqrt(int sum V_p0 e_p^2 dt / int sum V_p0 |x_exact - X_p|^2 dt) from t = 0 (reports/norms.py). Orders: pairwise "
     "p = ln(E_i/E_i+1)/ln(h_i/h_i+1) between consecutive usable levels; least-squares slope of ln E against ln h with "
     "a 95% Student-t interval (none with two levels). Class: stalled when the finest pairwise order is below "
     f"{orders.STALLED_BELOW}; non-asymptotic when the pairwise orders span more than {orders.ASYMPTOTIC_SPREAD}; "

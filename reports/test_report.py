@@ -212,6 +212,14 @@ columns = ["cells", "amplitude"]
 rows = [[32, 0.5, 0.47], [64, 0.5, 0.34], [256, 0.5, 1.0]]
 
 [[reference]]
+source = "another code, its figure 4"
+study = "ring"
+quantity = "error"
+norm = "L1_theta0"
+columns = ["cells", "amplitude"]
+rows = [[64, 0.5, 0.002]]
+
+[[reference]]
 source = "another code, figure 9"
 study = ["ring"]
 quantity = "order"
@@ -225,8 +233,10 @@ rows = [[0.5, 1.25]]
 def test_published_results_stand_beside_the_suites_own(tmp_path):
     """Requirement: a [[reference]] time_reached table puts, for each published row,
     the time each matching case reached (and why it stopped) beside the published
-    time, one column per method; an order table puts every matching series' observed
-    order beside the published one; the gate ignores both."""
+    time, one column per method; an error table puts each matching case's error in
+    the same norm (or why it has none) beside the published one; an order table puts
+    every matching series' observed order beside the published one; the gate ignores
+    them all."""
     directory = write_suite_directory(tmp_path / "suite", SYNTHETIC_SUITE + REFERENCE_TABLES, synthetic_ring_cases())
     written = render(directory, tmp_path / "out")[0]
     markdown = written["markdown"].read_text()
@@ -235,6 +245,10 @@ def test_published_results_stand_beside_the_suites_own(tmp_path):
     assert "| 32 | 0.5 | 0.47 | 1 | 1 |" in markdown
     assert "| 64 | 0.5 | 0.34 | 0.3 non-positive J | 1 |" in markdown
     assert "| 256 | 0.5 | 1 | 1 | pending |" in markdown
+    assert "## Against published results: L1_theta0" in markdown and "another code, its figure 4" in markdown
+    assert "| cells | amplitude | reference [rad] | ring method=linear | ring method=cpdi |" in markdown
+    error_row = next(line for line in markdown.splitlines() if line.startswith("| 64 | 0.5 | 0.002 |"))
+    assert "| no output at t = 1 (reached 0.3) |" in error_row       # the linear case stopped at 0.3 s
     assert "## Against published results: observed order of L1_theta0" in markdown
     rows = [line for line in markdown.splitlines() if line.startswith("| 0.5 | 1.25 | ring: ")]
     assert len(rows) == 2

@@ -28,6 +28,12 @@ struct EnergyLedger {
 
 struct Monitors {
   double kinetic = 0.0;        // sum m |v|^2 / 2
+  // sum m (x - o) x v about the origin o of coordinates [kg m^2/s per unit
+  // depth]; NaN in r-z. The internal forces exert no net torque on the grid
+  // (eq. 1.70 with a linearly complete basis and a symmetric stress), so it
+  // changes with the torque of what the scene applies (and what the
+  // transfers lose).
+  double angular_momentum = std::numeric_limits<double>::quiet_NaN();
   double strain = 0.0;         // sum V0 psi(F)
   double min_J = std::numeric_limits<double>::infinity();
   double max_J = 0.0;
@@ -45,16 +51,17 @@ Monitors monitor_particles(const Shape& shape, const Material& material, const P
                            const GridGeometry& grid, std::size_t begin = 0, std::size_t end = kAllParticles) {
   Monitors m;
   const std::size_t n = std::min(end, P.size());
-  double kinetic = 0.0, strain = 0.0, min_J = m.min_J, max_J = 0.0, mach = 0.0;
+  double kinetic = 0.0, strain = 0.0, min_J = m.min_J, max_J = 0.0, mach = 0.0, spin = 0.0;
   double distortion = 0.0;
   std::size_t near = 0;
   constexpr bool has_domain = !std::is_same_v<Shape, LinearShapeT<Shape::geometry>>;
-#pragma omp parallel for schedule(static) reduction(+ : kinetic, strain, near) reduction(min : min_J) \
+#pragma omp parallel for schedule(static) reduction(+ : kinetic, strain, near, spin) reduction(min : min_J) \
     reduction(max : max_J, mach, distortion)
   for (std::size_t p = begin; p < n; ++p) {
     const double F33 = out_of_plane_stretch<Shape::geometry>(P, p);
     const double J = determinant(P.deformation_gradient[p]) * F33;
     kinetic += 0.5 * P.mass[p] * P.velocity[p].squaredNorm();
+    spin += P.mass[p] * (P.position[p].x() * P.velocity[p].y() - P.position[p].y() * P.velocity[p].x());
     strain += P.reference_volume[p] * material.energy_density(P.deformation_gradient[p], F33);
     min_J = std::min(min_J, J);
     max_J = std::max(max_J, J);
@@ -76,6 +83,7 @@ Monitors monitor_particles(const Shape& shape, const Material& material, const P
     if (edge) ++near;
   }
   m.kinetic = kinetic;
+  if constexpr (Shape::geometry == Geometry::plane_strain) m.angular_momentum = spin;
   m.strain = strain;
   m.min_J = min_J;
   m.max_J = max_J;
@@ -89,6 +97,9 @@ Monitors monitor_particles(const Shape& shape, const Material& material, const P
 inline Monitors combined(const Monitors& a, const Monitors& b) {
   Monitors m;
   m.kinetic = a.kinetic + b.kinetic;
+  m.angular_momentum = std::isnan(a.angular_momentum)   ? b.angular_momentum
+                       : std::isnan(b.angular_momentum) ? a.angular_momentum
+                                                        : a.angular_momentum + b.angular_momentum;
   m.strain = a.strain + b.strain;
   m.min_J = std::min(a.min_J, b.min_J);
   m.max_J = std::max(a.max_J, b.max_J);

@@ -25,6 +25,14 @@ const char* to_string(TimeIntegration t) {
   return "?";
 }
 
+const char* to_string(TimeStepRule r) {
+  switch (r) {
+    case TimeStepRule::cfl: return "cfl";
+    case TimeStepRule::stable: return "stable";
+  }
+  return "?";
+}
+
 RunOutcome run_time_loop(Stepper& stepper, const TimeLoopOptions& options, RunObserver& observer,
                          const ProgressSink& progress, double progress_interval_seconds) {
   if (options.output_times.empty() || options.output_times.back() != options.end_time)
@@ -55,11 +63,44 @@ RunOutcome run_time_loop(Stepper& stepper, const TimeLoopOptions& options, RunOb
   ParticleScan scan = stepper.scan();
   if (scan.first_unhealthy < n()) fail(scan, t);
 
+  // TimeStepRule::stable: the last two measurements of omega_max, and the
+  // estimate at time t: the last one, raised along their growth since.
+  const bool stable_rule = options.step_rule == TimeStepRule::stable && options.fixed_step <= 0.0;
+  double omega_last = 0.0, omega_before = 0.0, t_last = 0.0, t_before = 0.0;
+  // False when the measurement gives no frequency; at the start that is a
+  // stepper without one (an implicit step), later a run to stop with its data.
+  auto measure = [&] {
+    omega_before = omega_last;
+    t_before = t_last;
+    omega_last = stepper.largest_frequency(options.track_iterations);
+    t_last = t;
+    ++out.frequency_measurements;
+    const bool measured = omega_last > 0.0 && std::isfinite(omega_last);
+    if (!measured && out.steps == 0)
+      throw std::invalid_argument("the stable time-step rule needs a stepper that measures its largest frequency "
+                                  "(an explicit step)");
+    return measured;
+  };
+  auto omega_now = [&] {
+    if (!(omega_before > 0.0 && t_last > t_before)) return omega_last;
+    return omega_last + std::max(0.0, (omega_last - omega_before) / (t_last - t_before)) * (t - t_last);
+  };
+
   while (out.failure_reason.empty() && next_output < options.output_times.size()) {
-    double dt = options.fixed_step > 0.0 ? options.fixed_step : options.cfl * h / scan.max_signal_speed;
+    if (stable_rule && out.steps % options.track_every == 0 && !measure()) {
+      out.failure_reason = "stable step unmeasured";
+      out.failure_detail = "the power iteration for omega_max gave " + std::to_string(omega_last) + " rad/s";
+      out.failure_time = t;
+      out.failure_step = out.steps;
+      break;
+    }
+    double dt = options.fixed_step > 0.0 ? options.fixed_step
+                : stable_rule             ? options.cfl * 2.0 / omega_now()
+                                          : options.cfl * h / scan.max_signal_speed;
+    observer.step_rule(dt);
     if (!std::isfinite(dt) || dt < smallest_step) {
       out.failure_reason = "time step collapsed";
-      out.failure_detail = "CFL step " + std::to_string(dt) + " s";
+      out.failure_detail = std::string(stable_rule ? "stable-rule" : "CFL") + " step " + std::to_string(dt) + " s";
       out.failure_time = t;
       out.failure_step = out.steps;
       break;

@@ -27,11 +27,32 @@ enum class TimeIntegration {
 
 const char* to_string(TimeIntegration t);
 
+// How long a step is.
+enum class TimeStepRule {
+  // dt = cfl h / max_p (c_p + |v_p|) (Stepper::scan, stages.hpp: scan_particles).
+  cfl,
+  // dt = cfl 2 / omega_max: a fraction of the stable step of central
+  // differences, omega_max measured by power iteration on the step's own
+  // linearization (Stepper::largest_frequency) every `track_every` steps and
+  // extrapolated in between along the growth of the last two measurements.
+  // For a linearization that is symmetric (the total Lagrangian
+  // formulation), where a particle-wise wave speed overstates the grid's
+  // largest frequency: in the stiff vortex on 30 cells
+  // (suites/stiff-vortex.toml) the particles' wave speed bound grows 48 times
+  // as the ring twists, omega_max 5.8 times.
+  stable,
+};
+
+const char* to_string(TimeStepRule r);
+
 struct TimeLoopOptions {
   double end_time = 1.0;
   // dt = cfl h / max_p (c_p + |v_p|): the material's wave speed bound at the
   // particle's current state plus its speed.
   double cfl = 0.5;
+  TimeStepRule step_rule = TimeStepRule::cfl;
+  int track_every = 50;       // TimeStepRule::stable: steps between measurements of omega_max
+  int track_iterations = 20;  // power iterations per measurement, each from the same fixed start
   TimeIntegration time_integration = TimeIntegration::central_difference;
   // When positive, every step is this long instead of the CFL step (the load
   // steps of an implicit static run).
@@ -55,6 +76,7 @@ struct RunOutcome {
   double dt_first = std::numeric_limits<double>::quiet_NaN();  // from the CFL condition
   double dt_min = std::numeric_limits<double>::quiet_NaN();
   double dt_max = std::numeric_limits<double>::quiet_NaN();
+  long long frequency_measurements = 0;  // TimeStepRule::stable: how often omega_max was measured
   std::size_t outputs_written = 0;
 };
 
@@ -63,6 +85,9 @@ class RunObserver {
   virtual ~RunObserver() = default;
   virtual void initial(const Stepper&) {}
   virtual void after_step(double /*t*/, const Stepper&) {}
+  // The step the time-step rule gave before this step (before any shortening
+  // to land on an output time).
+  virtual void step_rule(double /*dt*/) {}
   virtual void at_output(std::size_t /*index*/, double /*t*/, const Stepper&) {}
   // After an output: a reason to stop the run there (and its detail), when
   // the observer has one (an energy blow-up); empty to go on.

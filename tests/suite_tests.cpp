@@ -147,7 +147,12 @@ TEST(SuiteFile, MistakesNameFileLineAndKey) {
                "columns = [\"cels\"]\nrows = [[32, 0.4]]\n",
        "s.toml:9: [[reference]]: column 'cels' is not a key of study 'a'"},
       {study + "[[reference]]\nsource = \"x\"\nstudy = \"a\"\nquantity = \"speed\"\nrows = [[0.4]]\n",
-       "s.toml:7: [[reference]] needs 'quantity': \"time_reached\" or \"order\""},
+       "s.toml:7: [[reference]] needs 'quantity': \"time_reached\", \"error\" or \"order\""},
+      {study + "[[reference]]\nsource = \"x\"\nstudy = \"a\"\nquantity = \"error\"\nrows = [[0.1]]\n",
+       "s.toml:4: [[reference]]: an error needs 'norm'"},
+      {study + "[[reference]]\nsource = \"x\"\nstudy = \"a\"\nquantity = \"error\"\nnorm = \"particle_L2\"\n"
+               "rows = [[-0.1]]\n",
+       "the last value of a row is the error, a non-negative number"},
       {study + "[[reference]]\nsource = \"x\"\nstudy = [\"a\", \"b\"]\nquantity = \"order\"\nnorm = \"L1_theta0\"\nrows = [[2.0]]\n",
        "s.toml:6: [[reference]]: no study named 'b'"},
       {study + "[[reference]]\nsource = \"x\"\nstudy = \"a\"\nquantity = \"order\"\nrows = [[2.0]]\n",

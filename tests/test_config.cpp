@@ -260,6 +260,8 @@ TEST(SceneRules, CrossKeyRulesNameTheKey) {
       // h = 1 m is wider than the 0.5 m ring, with room to the walls.
       {{"domain=8", "cells=8"}, {"'cells'", "--set cells=8"}},
       {{"output_times=0.5,0.25"}, {"'output_times'", "--set output_times=0.5,0.25", "strictly increasing"}},
+      // The stable step is measured on a symmetric linearization only.
+      {{"time_step=stable"}, {"'time_step'", "formulation = \"total\"", "formulation = \"updated\""}},
   };
   const mpmvv::app::SceneType* ring = mpmvv::app::find_scene_type("ring");
   ASSERT_NE(ring, nullptr);

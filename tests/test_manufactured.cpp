@@ -560,28 +560,27 @@ TEST(RingClosedForm, DerivedForceEqualsEquations2_14To2_15) {
   }
 }
 
-// The closed form as the body-force stage (RingClosedFormBodyForce, after
-// prepare()) fills the same vectors as the derived stage (DerivedBodyForce)
-// for a set of particles at several times: the largest difference is below
-// 1e-12 of the largest force (measured 1.2e-15 to 4.4e-15).
-TEST(RingClosedForm, ClosedFormStageEqualsDerivedStage) {
+// The closed form as a force field (RingClosedFormField, after prepare())
+// fills the same vectors as the derived field (DerivedForceField) for a set of
+// points at several times: the largest difference is below 1e-12 of the
+// largest force (measured 1.2e-15 to 4.4e-15).
+TEST(RingClosedForm, ClosedFormFieldEqualsDerivedField) {
   for (const RingCase& c : kRingCases) {
     const RingParameters p = ring_parameters(c);
-    Particles P;
-    const std::vector<Sample> points = ring_samples(500, 23);
-    P.resize(points.size());
-    for (std::size_t k = 0; k < points.size(); ++k) P.reference_position[k] = P.position[k] = points[k].X;
-    mpmvv::mms::RingClosedFormBodyForce closed{RingMms(p)};
-    closed.prepare(P);
-    const mpmvv::mms::DerivedBodyForce derived(
+    std::vector<Vec2> X;
+    for (const Sample& s : ring_samples(500, 23)) X.push_back(s.X);
+    mpmvv::mms::RingClosedFormField closed{RingMms(p)};
+    closed.prepare(X);
+    mpmvv::mms::DerivedForceField derived(
         mpmvv::mms::make_solution(RingMotion{p}, NeoHookean{p.lambda, p.mu}, p.density, Geometry::plane_strain));
+    derived.prepare(X);
     double worst_relative = 0.0;
     for (double t : {0.0, 0.13, 0.5, 0.77, 1.0}) {
-      std::vector<Vec2> b_closed(P.size()), b_derived(P.size());
-      closed.evaluate(t, P, b_closed);
-      derived.evaluate(t, P, b_derived);
+      std::vector<Vec2> b_closed(X.size()), b_derived(X.size());
+      closed.evaluate(t, b_closed);
+      derived.evaluate(t, b_derived);
       double largest = 0.0, worst = 0.0;
-      for (std::size_t k = 0; k < P.size(); ++k) {
+      for (std::size_t k = 0; k < X.size(); ++k) {
         largest = std::max(largest, b_closed[k].norm());
         worst = std::max(worst, (b_closed[k] - b_derived[k]).norm());
       }

@@ -44,7 +44,9 @@ struct CpdiShapeT {
 
   // The domains span F_p diag(l_p); `deformation_gradient` may point to a copy
   // of F taken at the start of a step, so that every transfer of the step uses
-  // the same domains.
+  // the same domains. A shape whose `deformation_gradient` member is null
+  // weighs the reference domains diag(l_p), F = I (the total Lagrangian
+  // formulation sets it so, total_lagrangian.hpp).
   static CpdiShapeT bind(const GridGeometry& grid, const Particles& particles,
                          const Mat2* deformation_gradient = nullptr, double gradient_scale = 1.0) {
     return {&grid, particles.position.data(),
@@ -54,7 +56,7 @@ struct CpdiShapeT {
 
   // s_p = [r_1 r_2], the current domain half-vectors as columns (eq. 1.97).
   Mat2 domain(std::size_t p) const {
-    Mat2 s = deformation_gradient[p];
+    Mat2 s = deformation_gradient ? deformation_gradient[p] : Mat2::Identity();
     s.col(0) *= half_size[p].x();
     s.col(1) *= half_size[p].y();
     return s;

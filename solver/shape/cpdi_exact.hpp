@@ -125,9 +125,14 @@ struct CpdiExactShapeT {
             gradient_scale};
   }
 
+  // The map of the domain from the reference: F_p, or I when
+  // `deformation_gradient` is null (the reference domains of the total
+  // Lagrangian formulation, total_lagrangian.hpp).
+  Mat2 domain_map(std::size_t p) const { return deformation_gradient ? deformation_gradient[p] : Mat2::Identity(); }
+
   // s_p = [r_1 r_2], the current domain half-vectors as columns (eq. 1.97).
   Mat2 domain(std::size_t p) const {
-    Mat2 s = deformation_gradient[p];
+    Mat2 s = domain_map(p);
     s.col(0) *= half_size[p].x();
     s.col(1) *= half_size[p].y();
     return s;
@@ -139,7 +144,7 @@ struct CpdiExactShapeT {
   int outline(std::size_t p, Vec2* c) const {
     const Vec2 x = grid_coordinate(*grid, position[p]);
     if (domain_first != nullptr && domain_first[p + 1] > domain_first[p]) {
-      const Mat2 F = deformation_gradient[p] / grid->h;
+      const Mat2 F = domain_map(p) / grid->h;
       const int count = int(domain_first[p + 1] - domain_first[p]);
       const Vec2* d = domain_vertex + domain_first[p];
       for (int k = 0; k < count; ++k) c[k] = x + F * d[k];

@@ -21,7 +21,13 @@
 // The particles never leave the reference grid, so no cell crossing happens;
 // the formulation suits bodies whose material points keep their neighbours
 // (no fracture, no mixing), such as every manufactured scene here. Plane
-// strain, with the uGIMP basis, whose square reference domains tile the body.
+// strain. The reference basis is uGIMP, whose square reference domains tile
+// the body, or CPDI over the same squares (corner interpolation of the grid
+// basis, eq. 1.95 with F = I), or exact CPDI over each particle's exact
+// reference outline (a cut piece of a curved body keeps its true shape): the
+// domains never deform, so CPDI's large-shear trouble (stretched domains,
+// gradients beyond the grid basis) never arises, and the basis is fixed for
+// the run.
 #pragma once
 
 #include <algorithm>
@@ -29,6 +35,8 @@
 #include <cstddef>
 
 #include "../particles.hpp"
+#include "cpdi.hpp"
+#include "cpdi_exact.hpp"
 #include "gimp.hpp"
 #include "stencil.hpp"
 
@@ -50,9 +58,11 @@ struct TotalLagrangianShapeT {
   // `deformation_gradient` may point to a copy of F taken at the start of a
   // step, so that every transfer of the step maps the gradients alike.
   static TotalLagrangianShapeT bind(const GridGeometry& grid, const Particles& particles,
-                                    const Mat2* deformation_gradient = nullptr, double = 1.0) {
-    Reference r = Reference::bind(grid, particles);
+                                    const Mat2* deformation_gradient = nullptr, double gradient_scale = 1.0) {
+    Reference r = Reference::bind(grid, particles, nullptr, gradient_scale);
     r.position = particles.reference_position.data();
+    // CPDI weighs the reference domain: F = I (shape/cpdi.hpp).
+    if constexpr (Reference::reads_deformation_gradient) r.deformation_gradient = nullptr;
     return {r, deformation_gradient ? deformation_gradient : particles.deformation_gradient.data()};
   }
 
@@ -87,5 +97,7 @@ struct TotalLagrangianShapeT {
 };
 
 using TotalLagrangianGimpShape = TotalLagrangianShapeT<GimpShapeT<Geometry::plane_strain>>;
+using TotalLagrangianCpdiShape = TotalLagrangianShapeT<CpdiShapeT<Geometry::plane_strain>>;
+using TotalLagrangianCpdiExactShape = TotalLagrangianShapeT<CpdiExactShapeT<Geometry::plane_strain>>;
 
 }  // namespace mpmvv

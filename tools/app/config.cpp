@@ -2,6 +2,7 @@
 
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
@@ -210,6 +211,10 @@ void Config::set_from_text(const std::string& assignment) {
 const Value& Config::value(const std::string& key) const {
   spec(key);
   return values_.at(key);
+}
+
+bool Config::has(const std::string& key) const {
+  return std::any_of(specs_.begin(), specs_.end(), [&key](const KeySpec& s) { return s.name == key; });
 }
 
 const Origin& Config::origin(const std::string& key) const {

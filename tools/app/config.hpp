@@ -57,6 +57,8 @@ class Config {
   const std::vector<double>& reals(const std::string& key) const;
   const Value& value(const std::string& key) const;
   const Origin& origin(const std::string& key) const;
+  // Whether the scene declares the key.
+  bool has(const std::string& key) const;
 
   // Checks `value` against the key's declaration and stores it.
   void set(const std::string& key, Value value, Origin origin);

@@ -44,6 +44,16 @@ KeySpec seeding_key() {
           -inf, inf, false, false, choices};
 }
 
+KeySpec force_quadrature_key() {
+  const double inf = std::numeric_limits<double>::infinity();
+  return {"body_force_quadrature", KeyKind::text, std::string("centroid"),
+          "centroid: each particle takes the body force at its reference centroid; domain: the mean over its "
+          "reference domain by 2 x 2 Gauss points (mms/force_field.hpp), which removes the centroid rule's error of "
+          "order (h / particles_per_direction)^2 where the force is large against the motion it makes (a stiff "
+          "solid moved slowly)",
+          -inf, inf, false, false, {"centroid", "domain"}};
+}
+
 std::vector<KeySpec> problem_keys(std::vector<KeySpec> k, const std::vector<KeySpec>& own,
                                   const std::vector<KeySpec>& material) {
   k.insert(k.end(), own.begin(), own.end());
@@ -158,10 +168,10 @@ class MmsCase final : public SceneCase, private RunObserver {
       stages.second_material = setup_.second_material;
       stages.second_material_from = first_material_count_;
     }
-    if (!setup_.force_free) {
-      stages.body_force = setup_.fast_body_force;
-      if (!stages.body_force) stages.body_force = std::make_shared<mms::DerivedBodyForce>(setup_.solution);
-      if (fault_ == Fault::no_body_force) stages.body_force = nullptr;
+    if (!setup_.force_free && fault_ != Fault::no_body_force) {
+      std::shared_ptr<mms::ForceField> field = setup_.fast_body_force;
+      if (!field) field = std::make_shared<mms::DerivedForceField>(setup_.solution);
+      stages.body_force = std::make_shared<mms::ManufacturedBodyForce>(field, force_quadrature(), setup_.geometry);
     }
     if (implicit()) {
 #ifdef MPMVV_HAVE_SUNDIALS
@@ -178,17 +188,20 @@ class MmsCase final : public SceneCase, private RunObserver {
     return outcome_;
   }
 
-  bool implicit() const {
-    for (const KeySpec& k : config_.specs())
-      if (k.name == "solver") return config_.text("solver") == "implicit";
-    return false;
+  bool implicit() const { return config_.has("solver") && config_.text("solver") == "implicit"; }
+
+  mms::ForceQuadrature force_quadrature() const {
+    return config_.has("body_force_quadrature") && config_.text("body_force_quadrature") == "domain"
+               ? mms::ForceQuadrature::domain
+               : mms::ForceQuadrature::centroid;
   }
 
   double cell_size() const override { return setup_.grid.h; }
   Geometry geometry() const override { return setup_.geometry; }
   std::string body_force_kind() const override {
     if (setup_.force_free) return setup_.loading.empty() ? "none" : "none; " + setup_.loading;
-    return setup_.fast_body_force ? "closed form" : "derived";
+    const std::string kind = setup_.fast_body_force ? "closed form" : "derived";
+    return force_quadrature() == mms::ForceQuadrature::domain ? kind + ", mean over each particle's domain" : kind;
   }
   Measurements measurements() const override {
     if (!stepper_) return {};
@@ -221,7 +234,11 @@ class MmsCase final : public SceneCase, private RunObserver {
            "|q_sim - q_exact| for the line's quantity (its 'quantity' attribute; rad or m); particle_L1, "
            "particle_L2, particle_Linf: norms of the displacement error |x_p - x_exact(X_p, t)| over all "
            "particles, weighted by reference volume (m); particle_pressure_L2: the reference-volume-weighted RMS error "
-           "of the in-plane mean stress -(sigma_xx + sigma_yy)/2 (Pa); error_*: the scene's own relative errors "
+           "of the in-plane mean stress -(sigma_xx + sigma_yy)/2 (Pa); exact_displacement_L2: the reference-volume-"
+           "weighted RMS of the exact displacement |x_exact - X_p| (m); particle_relative_L2_integrated: "
+           "sqrt(int_0^t sum V_p0 |x_p - x_exact|^2 dt / int_0^t sum V_p0 |x_exact - X_p|^2 dt), trapezoid rule over "
+           "the start and the output times (the norm the total Lagrangian MPM literature reports for the ring); "
+           "error_*: the scene's own relative errors "
            "against its exact "
            "solution (reports/results-format.md)";
   }
@@ -289,7 +306,8 @@ class MmsCase final : public SceneCase, private RunObserver {
     g.set_attribute("description",
                     "the run's health at each output time (solver/monitors.hpp): kinetic and strain energy, the work "
                     "done on the particles by body forces and tractions, node constraints, contact and damping, the "
-                    "energy made from nothing (kinetic + strain - initial - work), J's range, the largest particle "
+                    "energy made from nothing (kinetic + strain - initial - work), the angular momentum about the origin and the "
+                    "exact motion's over the same particles [kg m^2/s per unit depth; NaN in r-z], J's range, the largest particle "
                     "speed over its wave speed, the largest CPDI domain distortion (1: square), particles at the "
                     "grid's edge [J per unit depth; per radian in r-z]");
     g.set_attribute("initial_energy", initial_energy_);
@@ -307,6 +325,8 @@ class MmsCase final : public SceneCase, private RunObserver {
     column("work_contact", [](const MonitorRow& r) { return r.work.contact; });
     column("work_damping", [](const MonitorRow& r) { return r.work.damping; });
     column("energy_created", [](const MonitorRow& r) { return r.created; });
+    column("angular_momentum", [](const MonitorRow& r) { return r.monitors.angular_momentum; });
+    column("exact_angular_momentum", [](const MonitorRow& r) { return r.exact_angular_momentum; });
     column("min_J", [](const MonitorRow& r) { return r.monitors.min_J; });
     column("max_J", [](const MonitorRow& r) { return r.monitors.max_J; });
     column("max_speed_over_wave_speed", [](const MonitorRow& r) { return r.monitors.max_mach; });
@@ -505,7 +525,8 @@ class MmsCase final : public SceneCase, private RunObserver {
     errors_ = ErrorTable{};
     for (const ProbeLine& line : setup_.lines) errors_.add_column("L1_" + line.name);
     if (setup_.exact_motion)
-      for (const char* name : {"particle_L1", "particle_L2", "particle_Linf", "particle_pressure_L2"})
+      for (const char* name : {"particle_L1", "particle_L2", "particle_Linf", "particle_pressure_L2",
+                               "exact_displacement_L2", "particle_relative_L2_integrated"})
         errors_.add_column(name);
     for (const std::string& name : setup_.extra_error_names) errors_.add_column(name);
     history_time_.clear();
@@ -520,8 +541,20 @@ class MmsCase final : public SceneCase, private RunObserver {
     return probe_value(q, setup_.geometry, x, X, x);
   }
 
-  // The energy at the start, for the balance (monitors.hpp).
+  // The energy at the start, for the balance (monitors.hpp), and the first
+  // point of the time-integrated error.
   void initial(const Stepper& s) override {
+    integrated_ = {};
+    if (setup_.exact_motion) {
+      const Particles& P = s.model().particles;
+      double error2 = 0.0, exact2 = 0.0;
+      for (std::size_t p = 0; p < P.size(); ++p) {
+        const Vec2 x_exact = setup_.solution->position(P.reference_position[p], 0.0);
+        error2 += P.reference_volume[p] * (P.position[p] - x_exact).squaredNorm();
+        exact2 += P.reference_volume[p] * (x_exact - P.reference_position[p]).squaredNorm();
+      }
+      integrated_.add(0.0, error2, exact2);
+    }
     const Monitors m = s.monitors();
     initial_energy_ = m.kinetic + m.strain;
     largest_energy_ = initial_energy_;
@@ -546,9 +579,20 @@ class MmsCase final : public SceneCase, private RunObserver {
     double frequency = std::numeric_limits<double>::quiet_NaN(), cfl_step = frequency;
     if (const int iterations = int(config_.integer("stable_step_iterations")); iterations > 0) {
       frequency = s.largest_frequency(iterations);
-      cfl_step = loop_.cfl * s.model().grid.h / s.scan().max_signal_speed;
+      cfl_step = rule_step_;
     }
-    monitor_rows_.push_back({t, m, w, created, frequency, cfl_step});
+    // The exact motion's angular momentum over the same particles, the
+    // reference the monitor is read against (the ring's spin, suites/stiff-vortex.toml).
+    double exact_spin = std::numeric_limits<double>::quiet_NaN();
+    if (setup_.exact_motion && setup_.geometry == Geometry::plane_strain) {
+      const Particles& P = s.model().particles;
+      exact_spin = 0.0;
+      for (std::size_t p = 0; p < P.size(); ++p) {
+        const mms::ExactFields f = setup_.solution->fields(P.reference_position[p], t);
+        exact_spin += P.mass[p] * (f.position.x() * f.velocity.y() - f.position.y() * f.velocity.x());
+      }
+    }
+    monitor_rows_.push_back({t, m, w, created, frequency, cfl_step, exact_spin});
     const double factor = config_.real("energy_blowup_factor");
     if (created > factor * largest_energy_ && created > 0.0)
       stop_ = {"energy blow-up",
@@ -556,6 +600,8 @@ class MmsCase final : public SceneCase, private RunObserver {
                            "started with or was given (energy_blowup_factor = {})",
                            t, created, created / largest_energy_, largest_energy_, factor)};
   }
+
+  void step_rule(double dt) override { rule_step_ = dt; }
 
   void after_step(double t, const Stepper& s) override {
     if (setup_.history) {
@@ -610,14 +656,16 @@ class MmsCase final : public SceneCase, private RunObserver {
     std::size_t column = setup_.lines.size();
     if (setup_.exact_motion) {
       const Particles& P = s.model().particles;
-      double weight = 0.0, l1 = 0.0, l2 = 0.0, linf = 0.0;
+      double weight = 0.0, l1 = 0.0, l2 = 0.0, linf = 0.0, exact2 = 0.0;
       for (std::size_t p = 0; p < P.size(); ++p) {
-        const double e = (P.position[p] - setup_.solution->position(P.reference_position[p], t)).norm();
+        const Vec2 x_exact = setup_.solution->position(P.reference_position[p], t);
+        const double e = (P.position[p] - x_exact).norm();
         const double w = P.reference_volume[p];
         weight += w;
         l1 += w * e;
         l2 += w * e * e;
         linf = std::max(linf, e);
+        exact2 += w * (x_exact - P.reference_position[p]).squaredNorm();
       }
       errors_.columns[column++].second.push_back(l1 / weight);
       errors_.columns[column++].second.push_back(std::sqrt(l2 / weight));
@@ -634,6 +682,9 @@ class MmsCase final : public SceneCase, private RunObserver {
         pressure += P.reference_volume[p] * e * e;
       }
       errors_.columns[column++].second.push_back(std::sqrt(pressure / weight));
+      errors_.columns[column++].second.push_back(std::sqrt(exact2 / weight));
+      integrated_.add(t, l2, exact2);
+      errors_.columns[column++].second.push_back(integrated_.relative());
     }
     if (!setup_.extra_error_names.empty()) {
       const std::vector<double> extra = setup_.extra_errors(t, RunRecord{point_time_, point_simulated_, s});
@@ -672,11 +723,37 @@ class MmsCase final : public SceneCase, private RunObserver {
     EnergyLedger work;
     double created;
     double largest_frequency, cfl_step;  // with stable_step_iterations > 0
+    double exact_angular_momentum;       // NaN without an exact motion (or in r-z)
   };
   std::vector<MonitorRow> monitor_rows_;
   double initial_energy_ = 0.0, largest_energy_ = 0.0;
+  double rule_step_ = std::numeric_limits<double>::quiet_NaN();  // the time-step rule's last step
   std::pair<std::string, std::string> stop_;
   ErrorTable errors_;
+  // The time-integrated relative L2 displacement error, the norm other codes
+  // publish for the ring (the vortex of the total Lagrangian MPM literature):
+  //   sqrt( int_0^t sum_p V_p0 |x_p - x_exact|^2 dt / int_0^t sum_p V_p0 |x_exact - X_p|^2 dt ),
+  // both integrals by the trapezoid rule over the start and the output times.
+  struct TimeIntegral {
+    double time = 0.0, error2 = 0.0, exact2 = 0.0;  // the last point
+    double error_integral = 0.0, exact_integral = 0.0;
+    bool started = false;
+    void add(double t, double e2, double u2) {
+      if (started) {
+        error_integral += 0.5 * (t - time) * (e2 + error2);
+        exact_integral += 0.5 * (t - time) * (u2 + exact2);
+      }
+      time = t;
+      error2 = e2;
+      exact2 = u2;
+      started = true;
+    }
+    double relative() const {
+      return exact_integral > 0.0 ? std::sqrt(error_integral / exact_integral)
+                                  : std::numeric_limits<double>::quiet_NaN();
+    }
+  };
+  TimeIntegral integrated_;
 };
 
 }  // namespace

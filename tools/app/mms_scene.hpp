@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "mms/exact_solution.hpp"
+#include "mms/force_field.hpp"
 #include "solver/boundary.hpp"
 #include "scene.hpp"
 #ifdef MPMVV_HAVE_CGAL
@@ -112,7 +113,7 @@ struct ProblemSetup {
   // A closed form that equals the derived force (tests/test_manufactured.cpp
   // shows it), used instead of automatic differentiation for speed; absent
   // otherwise.
-  std::shared_ptr<BodyForce> fast_body_force;
+  std::shared_ptr<mms::ForceField> fast_body_force;
 };
 
 struct MmsProblem {
@@ -131,6 +132,9 @@ std::unique_ptr<SceneCase> build_mms_case(const Config& config, const MmsProblem
 // The seeding key every manufactured problem accepts: "exact" (clipped
 // volumes, CGAL) by default when built with CGAL, else "centre".
 KeySpec seeding_key();
+// The key of every problem with a manufactured body force: where a particle
+// samples it (mms/force_field.hpp), "centroid" by default.
+KeySpec force_quadrature_key();
 
 // A problem's keys: the solver's, its own, the seeding key and the material's.
 std::vector<KeySpec> problem_keys(std::vector<KeySpec> solver, const std::vector<KeySpec>& own,

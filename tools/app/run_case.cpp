@@ -130,6 +130,7 @@ void write_results_file(const std::string& path, const RunRequest& request, cons
   root.set_attribute("dt", o.dt_first);
   root.set_attribute("dt_min", o.dt_min);
   root.set_attribute("dt_max", o.dt_max);
+  root.set_attribute("frequency_measurements", static_cast<double>(o.frequency_measurements));
   scene.write_results(root);
   write_errors(root, scene.errors(), scene.error_description());
   if (const auto m = scene.measurements(); !m.empty()) {

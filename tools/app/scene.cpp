@@ -51,7 +51,8 @@ std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_
       {"formulation", KeyKind::text, std::string("updated"),
        "updated: the grid is fixed in space and the particles move through it (the usual MPM); total: the grid is "
        "the body's reference configuration and each particle is weighed at its reference position for the whole "
-       "run (total Lagrangian MPM; method gimp, plane strain, no contact): no cell crossing, and the linearized "
+       "run (total Lagrangian MPM; method gimp, cpdi or cpdi-exact over reference domains, plane strain, no contact): no "
+       "cell crossing, and the linearized "
        "step of a stressed body stays symmetric (solver/shape/total_lagrangian.hpp)",
        -inf, inf, false, false, {"updated", "total"}},
       {"split_domains_beyond", KeyKind::real, 0.0,
@@ -71,10 +72,18 @@ std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_
       {"particles_per_direction", KeyKind::integer, std::int64_t(2),
        "particles per cell along each axis (2 means 4 per cell in 2D)", 1, 16},
       {"cfl", KeyKind::real, 0.3,
-       "time step as a fraction of h / max(wave speed + particle speed), the wave speed raised where a sheared CPDI "
+       "time step as a fraction of h / max(wave speed + particle speed) (with time_step = \"stable\": of the "
+       "measured stable step 2 / omega_max), the wave speed raised where a sheared CPDI "
        "domain's gradients exceed the grid basis's own (solver/stages.hpp: scan_particles); an undeformed 2D grid is "
        "stable to about 1/sqrt(2)",
        0.0, 1.0, true, false},
+      {"time_step", KeyKind::text, std::string("cfl"),
+       "cfl: dt = cfl h / max(wave speed + particle speed); stable: dt = cfl 2 / omega_max, the fraction cfl of the "
+       "stable step of central differences, omega_max measured by 20 power iterations on the step's linearization "
+       "every 50 steps and extrapolated in between (formulation = \"total\" only, whose linearization is "
+       "symmetric; solver/time_loop.hpp): a particle-wise wave speed overstates the grid's largest frequency where "
+       "a few particles are strongly compressed",
+       -inf, inf, false, false, {"cfl", "stable"}},
       {"end_time", KeyKind::real, default_end_time, "time at which the run stops [s]", 0.0, inf, true},
       {"output_times", KeyKind::real_list, std::move(default_output_times),
        "times at which probes and errors are recorded [s]; later than end_time are dropped, end_time is always one",
@@ -117,6 +126,13 @@ TimeLoopOptions time_loop_options(const Config& c) {
   TimeLoopOptions o;
   o.end_time = c.real("end_time");
   o.cfl = c.real("cfl");
+  if (c.text("time_step") == "stable") {
+    if (c.text("formulation") != "total")
+      c.reject("time_step", fmt::format("\"stable\" tracks omega_max by power iteration, which needs the symmetric "
+                                        "linearization of formulation = \"total\" (formulation = \"{}\" from {})",
+                                        c.text("formulation"), c.origin("formulation").source));
+    o.step_rule = TimeStepRule::stable;
+  }
   o.time_integration = c.text("time_integration") == "symplectic-euler" ? TimeIntegration::symplectic_euler
                                                                        : TimeIntegration::central_difference;
   const std::vector<double>& times = c.reals("output_times");
@@ -165,8 +181,9 @@ void write_errors(h5::Group& root, const ErrorTable& errors, const std::string& 
 void write_particles(h5::Group& root, const Particles& P) {
   h5::Group g = root.create_group("particles");
   const std::size_t n = P.size();
-  std::vector<double> X(2 * n), x(2 * n), v(2 * n), V(n), J(n);
+  std::vector<double> X(2 * n), x(2 * n), v(2 * n), V(n), J(n), F(4 * n);
   for (std::size_t p = 0; p < n; ++p) {
+    for (int k = 0; k < 4; ++k) F[4 * p + std::size_t(k)] = P.deformation_gradient[p](k / 2, k % 2);
     X[2 * p] = P.reference_position[p].x();
     X[2 * p + 1] = P.reference_position[p].y();
     x[2 * p] = P.position[p].x();
@@ -181,6 +198,7 @@ void write_particles(h5::Group& root, const Particles& P) {
   g.write("velocity", v, {n, 2});
   g.write("volume", V, {n});
   g.write("J", J, {n});
+  g.write("deformation_gradient", F, {n, 2, 2});
 }
 
 }  // namespace mpmvv::app

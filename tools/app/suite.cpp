@@ -220,8 +220,8 @@ bool case_has(const SuiteCase& c, const std::string& key, const Value& value) {
 }
 
 // [[reference]] tables: published numbers the report sets beside the suite's
-// own (suites/README.md), e.g. the time each run of another code reached, or
-// the order it observed. They check nothing; the gate ignores them. Each names
+// own (suites/README.md), e.g. the time each run of another code reached, the
+// error it reached, or the order it observed. They check nothing; the gate ignores them. Each names
 // studies of the suite, keys of their scenes, and rows that match cases.
 void check_references(const toml::table& top, const std::string& path,
                       const std::map<std::string, std::vector<KeySpec>>& study_keys, const Suite& suite) {
@@ -250,16 +250,16 @@ void check_references(const toml::table& top, const std::string& path,
 
     const toml::node* quantity = r.get("quantity");
     const std::string what = quantity && quantity->is_string() ? quantity->as_string()->get() : "";
-    if (what != "time_reached" && what != "order")
-      throw ConfigError(fmt::format("{}: [[reference]] needs 'quantity': \"time_reached\" or \"order\"",
+    if (what != "time_reached" && what != "order" && what != "error")
+      throw ConfigError(fmt::format("{}: [[reference]] needs 'quantity': \"time_reached\", \"error\" or \"order\"",
                                     quantity ? where_in(path, *quantity) : here));
     const toml::node* norm = r.get("norm");
     const toml::node* time = r.get("time");
-    if (what == "order" && (!norm || !norm->is_string()))
-      throw ConfigError(fmt::format("{}: [[reference]]: an order needs 'norm' (an /errors column)", here));
+    if (what != "time_reached" && (!norm || !norm->is_string()))
+      throw ConfigError(fmt::format("{}: [[reference]]: an {} needs 'norm' (an /errors column)", here, what));
     if (what == "time_reached" && (norm || time))
-      throw ConfigError(fmt::format("{}: [[reference]]: 'norm' and 'time' belong to an order, not to time_reached",
-                                    where_in(path, norm ? *norm : *time)));
+      throw ConfigError(fmt::format("{}: [[reference]]: 'norm' and 'time' belong to an error or an order, not to "
+                                    "time_reached", where_in(path, norm ? *norm : *time)));
     if (time && !(time->value<double>().value_or(-1.0) >= 0.0))
       throw ConfigError(fmt::format("{}: [[reference]]: 'time' must be a time >= 0", where_in(path, *time)));
 
@@ -299,9 +299,10 @@ void check_references(const toml::table& top, const std::string& path,
       }
       const toml::node& last = *cells.get(columns.size());
       const double value = last.value<double>().value_or(std::nan(""));
-      if (!(last.is_integer() || last.is_floating_point()) || !std::isfinite(value) || (what == "time_reached" && value < 0.0))
+      const bool non_negative = what != "order";
+      if (!(last.is_integer() || last.is_floating_point()) || !std::isfinite(value) || (non_negative && value < 0.0))
         throw ConfigError(fmt::format("{}: [[reference]]: the last value of a row is the {}, a {}number", at, what,
-                                      what == "time_reached" ? "non-negative " : ""));
+                                      non_negative ? "non-negative " : ""));
       const bool matched = std::any_of(suite.cases.begin(), suite.cases.end(), [&](const SuiteCase& c) {
         if (std::find(studies.begin(), studies.end(), c.study) == studies.end()) return false;
         for (std::size_t i = 0; i < columns.size(); ++i)

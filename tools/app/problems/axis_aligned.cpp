@@ -17,6 +17,7 @@ std::vector<KeySpec> keys() {
   const double inf = std::numeric_limits<double>::infinity();
   std::vector<KeySpec> k = solver_keys(32, 0.02, {0.005, 0.01, 0.015, 0.02});
   const std::vector<KeySpec> own = {
+      force_quadrature_key(),
       {"variant", KeyKind::text, std::string("2d"),
        "2d: the unit square; 1d: u = A sin(2 pi X / L) cos(c pi t / L) on a strip in uniaxial strain", -inf, inf,
        false, false, {"2d", "1d"}},

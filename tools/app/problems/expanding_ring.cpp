@@ -20,6 +20,7 @@ std::vector<KeySpec> keys() {
   const double inf = std::numeric_limits<double>::infinity();
   std::vector<KeySpec> k = solver_keys(64, 0.02, {0.005, 0.01, 0.015, 0.02});
   const std::vector<KeySpec> own = {
+      force_quadrature_key(),
       {"amplitude", KeyKind::real, 0.1, "A of u = A sin(C pi t / (2 r_b)) (c1 + c2 R + c3 R^2) X", 0.0, 1.0, true},
       {"inner_radius", KeyKind::real, 0.4, "r_i [m]", 0.0, inf, true},
       {"outer_radius", KeyKind::real, 0.6, "r_o [m]", 0.0, inf, true},

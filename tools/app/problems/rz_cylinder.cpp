@@ -18,6 +18,7 @@ std::vector<KeySpec> keys() {
   const double inf = std::numeric_limits<double>::infinity();
   std::vector<KeySpec> k = solver_keys(32, 1.0, {0.25, 0.5, 0.75, 1.0});
   const std::vector<KeySpec> own = {
+      force_quadrature_key(),
       {"amplitude", KeyKind::real, 0.2, "A: the largest of g(t) = (A/2)(1 - cos 2 pi t / T)", 0.0, 1.0, true},
       {"inner_radius", KeyKind::real, 0.25, "R_i [m]; 0 for a solid cylinder with particles up to the axis", 0.0, inf},
       {"outer_radius", KeyKind::real, 1.0, "R_o [m]", 0.0, inf, true},
