@@ -497,7 +497,8 @@ std::unique_ptr<Stepper> make_for_geometry(Model model, const SolverOptions& o, 
         case Method::cpdi: return make_for_shape<TotalLagrangianCpdiShape>(std::move(model), o, material, std::move(stages));
         case Method::cpdi_exact:
           return make_for_shape<TotalLagrangianCpdiExactShape>(std::move(model), o, material, std::move(stages));
-        case Method::linear: break;  // refused in make_stepper
+        case Method::linear:
+          return make_for_shape<TotalLagrangianLinearShape>(std::move(model), o, material, std::move(stages));
       }
   switch (o.method) {
     case Method::linear: return make_for_shape<LinearShapeT<G>>(std::move(model), o, material, std::move(stages));
@@ -550,9 +551,6 @@ std::unique_ptr<Stepper> make_stepper(Model model, const SolverOptions& options,
   }
   if (options.formulation == Formulation::total) {
     // What the reference grid cannot do yet, or does not need.
-    if (options.method == Method::linear)
-      throw std::invalid_argument("the total Lagrangian formulation weighs particles over their reference domains: "
-                                  "method gimp, cpdi or cpdi-exact, not linear");
     if (options.split_domains_beyond > 0.0)
       throw std::invalid_argument("split_domains_beyond serves the updated formulation: total Lagrangian domains "
                                   "never deform");

@@ -67,6 +67,8 @@ RunOutcome run_time_loop(Stepper& stepper, const TimeLoopOptions& options, RunOb
   // estimate at time t: the last one, raised along their growth since.
   const bool stable_rule = options.step_rule == TimeStepRule::stable && options.fixed_step <= 0.0;
   double omega_last = 0.0, omega_before = 0.0, t_last = 0.0, t_before = 0.0;
+  double signal_at_measurement = 0.0;
+  long long steps_at_measurement = 0;
   // False when the measurement gives no frequency; at the start that is a
   // stepper without one (an implicit step), later a run to stop with its data.
   auto measure = [&] {
@@ -74,6 +76,8 @@ RunOutcome run_time_loop(Stepper& stepper, const TimeLoopOptions& options, RunOb
     t_before = t_last;
     omega_last = stepper.largest_frequency(options.track_iterations);
     t_last = t;
+    signal_at_measurement = scan.max_signal_speed;
+    steps_at_measurement = out.steps;
     ++out.frequency_measurements;
     const bool measured = omega_last > 0.0 && std::isfinite(omega_last);
     if (!measured && out.steps == 0)
@@ -87,7 +91,9 @@ RunOutcome run_time_loop(Stepper& stepper, const TimeLoopOptions& options, RunOb
   };
 
   while (out.failure_reason.empty() && next_output < options.output_times.size()) {
-    if (stable_rule && out.steps % options.track_every == 0 && !measure()) {
+    const bool due = out.steps == 0 || out.steps - steps_at_measurement >= options.track_every ||
+                     scan.max_signal_speed > options.track_growth * signal_at_measurement;
+    if (stable_rule && due && !measure()) {
       out.failure_reason = "stable step unmeasured";
       out.failure_detail = "the power iteration for omega_max gave " + std::to_string(omega_last) + " rad/s";
       out.failure_time = t;

@@ -7,36 +7,20 @@
 // not; the time-integrated norm is the trapezoid rule over the stored columns.
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-
 #include <cmath>
-#include <cstdlib>
-#include <filesystem>
 #include <string>
 #include <vector>
 
+#include "run_scene.hpp"
 #include "solver/io/hdf5.hpp"
 
 namespace {
 
-namespace fs = std::filesystem;
+using mpmvv::testing::monitor;
 
 // Runs the stiff vortex scene with the overrides into a results file and opens it.
 mpmvv::h5::File run_vortex(const std::string& name, const std::string& overrides) {
-  const fs::path dir = fs::temp_directory_path() / "mpmvv-stiff-vortex-test";
-  fs::create_directories(dir);
-  const fs::path out = dir / (name + ".h5");
-  fs::remove(out);
-  const std::string command = std::string(MPMVV_BINARY) + " run " + MPMVV_SOURCE_DIR +
-                              "/suites/scenes/stiff-vortex.toml -q -t 1 " + overrides + " -o " + out.string() +
-                              " > /dev/null 2>&1";
-  const int status = std::system(command.c_str());
-  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << command;
-  return mpmvv::h5::File::open_read(out.string());
-}
-
-std::vector<double> monitor(const mpmvv::h5::File& f, const std::string& name) {
-  return f.root().open_group("probes").open_group("monitors").read_doubles(name);
+  return mpmvv::testing::run_scene("stiff-vortex.toml", "vortex-" + name, overrides);
 }
 
 std::vector<double> error_column(const mpmvv::h5::File& f, const std::string& name) {

@@ -21,8 +21,10 @@
 // The particles never leave the reference grid, so no cell crossing happens;
 // the formulation suits bodies whose material points keep their neighbours
 // (no fracture, no mixing), such as every manufactured scene here. Plane
-// strain. The reference basis is uGIMP, whose square reference domains tile
-// the body, or CPDI over the same squares (corner interpolation of the grid
+// strain. The reference basis is the bilinear hat at X_p (linear MPM; the
+// particle a point, the basis the grid's own, as in the total Lagrangian MPM
+// literature), or uGIMP, whose square reference domains tile the body, or
+// CPDI over the same squares (corner interpolation of the grid
 // basis, eq. 1.95 with F = I), or exact CPDI over each particle's exact
 // reference outline (a cut piece of a curved body keeps its true shape): the
 // domains never deform, so CPDI's large-shear trouble (stretched domains,
@@ -38,6 +40,7 @@
 #include "cpdi.hpp"
 #include "cpdi_exact.hpp"
 #include "gimp.hpp"
+#include "linear.hpp"
 #include "stencil.hpp"
 
 namespace mpmvv {
@@ -96,6 +99,7 @@ struct TotalLagrangianShapeT {
   }
 };
 
+using TotalLagrangianLinearShape = TotalLagrangianShapeT<LinearShapeT<Geometry::plane_strain>>;
 using TotalLagrangianGimpShape = TotalLagrangianShapeT<GimpShapeT<Geometry::plane_strain>>;
 using TotalLagrangianCpdiShape = TotalLagrangianShapeT<CpdiShapeT<Geometry::plane_strain>>;
 using TotalLagrangianCpdiExactShape = TotalLagrangianShapeT<CpdiExactShapeT<Geometry::plane_strain>>;

@@ -51,7 +51,7 @@ std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_
       {"formulation", KeyKind::text, std::string("updated"),
        "updated: the grid is fixed in space and the particles move through it (the usual MPM); total: the grid is "
        "the body's reference configuration and each particle is weighed at its reference position for the whole "
-       "run (total Lagrangian MPM; method gimp, cpdi or cpdi-exact over reference domains, plane strain, no contact): no "
+       "run (total Lagrangian MPM; every method, weighed at the reference positions and domains, plane strain, no contact): no "
        "cell crossing, and the linearized "
        "step of a stressed body stays symmetric (solver/shape/total_lagrangian.hpp)",
        -inf, inf, false, false, {"updated", "total"}},
@@ -80,7 +80,7 @@ std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_
       {"time_step", KeyKind::text, std::string("cfl"),
        "cfl: dt = cfl h / max(wave speed + particle speed); stable: dt = cfl 2 / omega_max, the fraction cfl of the "
        "stable step of central differences, omega_max measured by 20 power iterations on the step's linearization "
-       "every 50 steps and extrapolated in between (formulation = \"total\" only, whose linearization is "
+       "every 50 steps (sooner when the particles' wave-speed bound grows by 10 %) and extrapolated in between (formulation = \"total\" only, whose linearization is "
        "symmetric; solver/time_loop.hpp): a particle-wise wave speed overstates the grid's largest frequency where "
        "a few particles are strongly compressed",
        -inf, inf, false, false, {"cfl", "stable"}},
