@@ -541,19 +541,34 @@ class MmsCase final : public SceneCase, private RunObserver {
     return probe_value(q, setup_.geometry, x, X, x);
   }
 
+  // Sums over the particles, weighted by reference volume V_p0, of the
+  // displacement error e_p = |x_p - x_exact(X_p, t)| (e, e^2, its largest)
+  // and of the exact displacement |x_exact - X_p|^2.
+  struct DisplacementSums {
+    double weight = 0.0, l1 = 0.0, l2 = 0.0, linf = 0.0, exact2 = 0.0;
+  };
+  DisplacementSums displacement_sums(const Particles& P, double t) const {
+    DisplacementSums d;
+    for (std::size_t p = 0; p < P.size(); ++p) {
+      const Vec2 x_exact = setup_.solution->position(P.reference_position[p], t);
+      const double e = (P.position[p] - x_exact).norm();
+      const double w = P.reference_volume[p];
+      d.weight += w;
+      d.l1 += w * e;
+      d.l2 += w * e * e;
+      d.linf = std::max(d.linf, e);
+      d.exact2 += w * (x_exact - P.reference_position[p]).squaredNorm();
+    }
+    return d;
+  }
+
   // The energy at the start, for the balance (monitors.hpp), and the first
   // point of the time-integrated error.
   void initial(const Stepper& s) override {
     integrated_ = {};
     if (setup_.exact_motion) {
-      const Particles& P = s.model().particles;
-      double error2 = 0.0, exact2 = 0.0;
-      for (std::size_t p = 0; p < P.size(); ++p) {
-        const Vec2 x_exact = setup_.solution->position(P.reference_position[p], 0.0);
-        error2 += P.reference_volume[p] * (P.position[p] - x_exact).squaredNorm();
-        exact2 += P.reference_volume[p] * (x_exact - P.reference_position[p]).squaredNorm();
-      }
-      integrated_.add(0.0, error2, exact2);
+      const DisplacementSums d = displacement_sums(s.model().particles, 0.0);
+      integrated_.add(0.0, d.l2, d.exact2);
     }
     const Monitors m = s.monitors();
     initial_energy_ = m.kinetic + m.strain;
@@ -656,20 +671,11 @@ class MmsCase final : public SceneCase, private RunObserver {
     std::size_t column = setup_.lines.size();
     if (setup_.exact_motion) {
       const Particles& P = s.model().particles;
-      double weight = 0.0, l1 = 0.0, l2 = 0.0, linf = 0.0, exact2 = 0.0;
-      for (std::size_t p = 0; p < P.size(); ++p) {
-        const Vec2 x_exact = setup_.solution->position(P.reference_position[p], t);
-        const double e = (P.position[p] - x_exact).norm();
-        const double w = P.reference_volume[p];
-        weight += w;
-        l1 += w * e;
-        l2 += w * e * e;
-        linf = std::max(linf, e);
-        exact2 += w * (x_exact - P.reference_position[p]).squaredNorm();
-      }
-      errors_.columns[column++].second.push_back(l1 / weight);
-      errors_.columns[column++].second.push_back(std::sqrt(l2 / weight));
-      errors_.columns[column++].second.push_back(linf);
+      const DisplacementSums d = displacement_sums(P, t);
+      const double weight = d.weight;
+      errors_.columns[column++].second.push_back(d.l1 / weight);
+      errors_.columns[column++].second.push_back(std::sqrt(d.l2 / weight));
+      errors_.columns[column++].second.push_back(d.linf);
       // The in-plane mean stress -(sigma_xx + sigma_yy) / 2 against the exact
       // one: its volume-weighted RMS error shows the pressure oscillation of
       // a nearly incompressible solid (volumetric locking).
@@ -682,8 +688,8 @@ class MmsCase final : public SceneCase, private RunObserver {
         pressure += P.reference_volume[p] * e * e;
       }
       errors_.columns[column++].second.push_back(std::sqrt(pressure / weight));
-      errors_.columns[column++].second.push_back(std::sqrt(exact2 / weight));
-      integrated_.add(t, l2, exact2);
+      errors_.columns[column++].second.push_back(std::sqrt(d.exact2 / weight));
+      integrated_.add(t, d.l2, d.exact2);
       errors_.columns[column++].second.push_back(integrated_.relative());
     }
     if (!setup_.extra_error_names.empty()) {
