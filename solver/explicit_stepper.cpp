@@ -47,11 +47,12 @@ namespace {
 template <class Shape, class Material>
 class ExplicitStepper final : public Stepper {
  public:
-  ExplicitStepper(Model model, Scheme scheme, Material material, std::optional<Material> second_material,
-                  SceneStages stages, double gradient_scale,
+  ExplicitStepper(Model model, Scheme scheme, VelocityTransfer transfer, Material material,
+                  std::optional<Material> second_material, SceneStages stages, double gradient_scale,
                   Dilatation dilatation, double split_length, double viscosity_linear, double viscosity_quadratic)
       : Stepper(std::move(model)),
         scheme_(scheme),
+        apic_(transfer == VelocityTransfer::apic),
         gradient_scale_(gradient_scale),
         dilatation_(dilatation),
         split_length_(split_length),
@@ -72,6 +73,8 @@ class ExplicitStepper final : public Stepper {
       model_.particles.body_force.assign(model_.particles.size(), Vec2::Zero());
     }
     if (scheme_ == Scheme::musl) next_position_.resize(model_.particles.size());
+    // The affine part starts at zero: the first map is FLIP's.
+    if (apic_) model_.particles.affine_velocity.assign(model_.particles.size(), Mat2::Zero());
     if (dilatation_ != Dilatation::particle) volume_sums_.resize(std::size_t(max_threads()));
     if (damping_ > 0.0) {
       fixed_components_.assign(2 * model_.grid.node_count(), 0);
@@ -237,7 +240,7 @@ class ExplicitStepper final : public Stepper {
     advance_grid(shape, t, dt, kick);
     move_tracers(dt);
     remember_volumes();
-    grid_to_particles<kVelocity | kPosition | kDeformation, Shape>(shape, fields_, P, dt, kick);
+    velocities_from_grid<kVelocity | kPosition | kDeformation>(shape, fields_, dt, kick);
     update_stress_of_particles(dt);
     book_body_work(dt);
   }
@@ -252,9 +255,9 @@ class ExplicitStepper final : public Stepper {
     if (body_force_) evaluate_body_force(t);
     for (const auto& [range, field] : {std::pair{a, &fields_}, std::pair{b, &fields_b_}}) {
       if (body_force_)
-        particles_to_grid<kMass | kMomentum | kInternalForce | kBodyForce>(shape, P, buffers_, *field, range);
+        momentum_to_grid<kMass | kMomentum | kInternalForce | kBodyForce>(shape, *field, range);
       else
-        particles_to_grid<kMass | kMomentum | kInternalForce>(shape, P, buffers_, *field, range);
+        momentum_to_grid<kMass | kMomentum | kInternalForce>(shape, *field, range);
     }
     mass_gradient_to_grid(shape, P, a.first, a.last, gradient_buffers_, gradient_a_);
     mass_gradient_to_grid(shape, P, b.first, P.size(), gradient_buffers_, gradient_b_);
@@ -274,8 +277,8 @@ class ExplicitStepper final : public Stepper {
     apply_body_contact(fields_, fields_b_, gradient_a_, gradient_b_, kick, contact_forces_);
     move_tracers(dt);
     remember_volumes();
-    grid_to_particles<kVelocity | kPosition | kDeformation, Shape>(shape, fields_, P, dt, kick, nullptr, a);
-    grid_to_particles<kVelocity | kPosition | kDeformation, Shape>(shape, fields_b_, P, dt, kick, nullptr, b);
+    velocities_from_grid<kVelocity | kPosition | kDeformation>(shape, fields_, dt, kick, nullptr, a);
+    velocities_from_grid<kVelocity | kPosition | kDeformation>(shape, fields_b_, dt, kick, nullptr, b);
     update_stress_of_particles(dt);
     book_body_work(dt);
   }
@@ -293,7 +296,7 @@ class ExplicitStepper final : public Stepper {
       domain_deformation = step_start_deformation_.data();
     }
     const Shape shape = bind(P, domain_deformation);
-    particles_to_grid<kMass | kMomentum>(shape, P, buffers_, fields_);
+    momentum_to_grid<kMass | kMomentum>(shape, fields_);
     grid_velocity_from_momentum(fields_);
     apply_walls(model_.grid, fields_);
     if (!constraints_.empty()) apply_constraints(constraints_, t, dt, kick, fields_);
@@ -308,7 +311,7 @@ class ExplicitStepper final : public Stepper {
     }
     advance_grid(shape, t, dt, kick);
     move_tracers(dt);
-    grid_to_particles<kVelocity | kPosition, Shape>(shape, fields_, P, dt, kick);
+    velocities_from_grid<kVelocity | kPosition>(shape, fields_, dt, kick);
     book_body_work(dt);
   }
 
@@ -320,8 +323,8 @@ class ExplicitStepper final : public Stepper {
     map_mass_momentum_and_forces(shape, t);
     advance_grid(shape, t, dt, kick);
     move_tracers(dt);
-    grid_to_particles<kVelocity | kPosition, Shape>(shape, fields_, P, dt, kick, next_position_.data());
-    particles_to_grid<kMomentum>(shape, P, buffers_, fields_);
+    velocities_from_grid<kVelocity | kPosition>(shape, fields_, dt, kick, next_position_.data());
+    momentum_to_grid<kMomentum>(shape, fields_);
     grid_velocity_from_momentum(fields_);
     apply_walls(model_.grid, fields_);
     if (!constraints_.empty()) apply_constraints(constraints_, t, dt, kick, fields_);
@@ -337,13 +340,31 @@ class ExplicitStepper final : public Stepper {
   }
 
   void map_mass_momentum_and_forces(const Shape& shape, double t) {
-    Particles& P = model_.particles;
     if (body_force_) {
       evaluate_body_force(t);
-      particles_to_grid<kMass | kMomentum | kInternalForce | kBodyForce>(shape, P, buffers_, fields_);
+      momentum_to_grid<kMass | kMomentum | kInternalForce | kBodyForce>(shape, fields_);
     } else {
-      particles_to_grid<kMass | kMomentum | kInternalForce>(shape, P, buffers_, fields_);
+      momentum_to_grid<kMass | kMomentum | kInternalForce>(shape, fields_);
     }
+  }
+
+  // The velocity transfer is chosen here, once per stage: under APIC every
+  // map of momentum carries the particles' affine fields, and every velocity
+  // update takes the grid's velocity and its gradient (model.hpp).
+  template <unsigned Fields>
+  void momentum_to_grid(const Shape& shape, GridFields& g, ParticleRange range = {}) {
+    if (apic_)
+      particles_to_grid<Fields | kAffineMomentum>(shape, model_.particles, buffers_, g, range, &model_.grid);
+    else
+      particles_to_grid<Fields>(shape, model_.particles, buffers_, g, range);
+  }
+  template <unsigned Updates>
+  void velocities_from_grid(const Shape& shape, const GridFields& g, double dt, double kick,
+                            Vec2* position_out = nullptr, ParticleRange range = {}) {
+    if (apic_)
+      grid_to_particles<Updates | kAffine, Shape>(shape, g, model_.particles, dt, kick, position_out, range);
+    else
+      grid_to_particles<Updates, Shape>(shape, g, model_.particles, dt, kick, position_out, range);
   }
 
   // The constitutive update, after the locking remedy when the run has it,
@@ -441,6 +462,7 @@ class ExplicitStepper final : public Stepper {
   }
 
   Scheme scheme_;
+  bool apic_;  // velocity_transfer = apic
   double gradient_scale_;
   Dilatation dilatation_;
   double split_length_;  // CPDI domains longer than this are split in two (split.hpp); 0: never
@@ -479,7 +501,8 @@ std::unique_ptr<Stepper> make_for_shape(Model model, const SolverOptions& o, con
           if (!same) throw std::invalid_argument("the second material must be a model of the same kind as the first");
           second = *same;
         }
-        return std::make_unique<ExplicitStepper<Shape, Material>>(std::move(model), o.scheme, m, std::move(second),
+        return std::make_unique<ExplicitStepper<Shape, Material>>(std::move(model), o.scheme, o.velocity_transfer, m,
+                                                                 std::move(second),
                                                                  std::move(stages),
                                                                  o.cpdi_gradient_scale, o.dilatation,
                                                                  o.split_domains_beyond * model.grid.h,
@@ -564,6 +587,16 @@ std::unique_ptr<Stepper> make_stepper(Model model, const SolverOptions& options,
   }
   if (!(options.bulk_viscosity_linear >= 0.0 && options.bulk_viscosity_quadratic >= 0.0))
     throw std::invalid_argument("the bulk viscosity coefficients must be zero (none) or positive");
+  if (options.velocity_transfer == VelocityTransfer::apic) {
+    // The affine field is x_g - x_p in the current configuration; the total
+    // formulation weighs reference positions, and in r-z the weights are not
+    // shown to reproduce linear fields.
+    if (options.formulation == Formulation::total)
+      throw std::invalid_argument("velocity_transfer = apic serves the updated formulation (the total formulation "
+                                  "weighs the particles at their reference positions)");
+    if (options.geometry != Geometry::plane_strain)
+      throw std::invalid_argument("velocity_transfer = apic is plane strain only");
+  }
   if (stages.contact && !stages.contact->displacement)
     throw std::invalid_argument("a contact master needs its displacement d(t)");
   if (stages.second_material) {

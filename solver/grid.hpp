@@ -33,6 +33,10 @@ struct GridGeometry {
   std::size_t node_count() const { return std::size_t(nodes_x()) * std::size_t(nodes_y()); }
   int node(int i, int j) const { return j * nodes_x() + i; }
   Vec2 node_position(int i, int j) const { return origin + h * Vec2(i, j); }
+  Vec2 node_position(std::size_t node) const {
+    const int row = int(node / std::size_t(nodes_x()));
+    return node_position(int(node) - row * nodes_x(), row);
+  }
   Vec2 upper() const { return origin + h * Vec2(cells_x, cells_y); }
 };
 

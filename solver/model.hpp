@@ -27,6 +27,14 @@ enum class Dilatation { particle, cell_averaged, node_smoothed };
 // (updated), or the body's reference configuration, each particle weighed at
 // its reference position for the whole run (total; shape/total_lagrangian.hpp).
 enum class Formulation { updated, total };
+// How particle velocities come back from the grid (stages.hpp: grid_to_particles).
+// flip: each particle keeps its velocity and adds the grid's acceleration
+// (eq. 1.76); what the grid cannot represent stays on the particles for the
+// whole run. apic: each particle takes the grid's velocity and its gradient
+// C_p and maps back the affine field v_p + C_p (x - x_p) (affine
+// particle-in-cell): affine motion is carried without loss, the rest is damped
+// at every step.
+enum class VelocityTransfer { flip, apic };
 
 const char* to_string(Method m);
 const char* to_string(Scheme s);
@@ -44,6 +52,7 @@ struct SolverOptions {
   double cpdi_gradient_scale = 1.0;
   Dilatation dilatation = Dilatation::particle;
   Formulation formulation = Formulation::updated;
+  VelocityTransfer velocity_transfer = VelocityTransfer::flip;
   // CPDI only: a domain longer than this many cells along one of its vectors
   // is split in two along it after a step (split.hpp); 0: never.
   double split_domains_beyond = 0.0;

@@ -43,6 +43,10 @@ struct Particles {
   std::vector<double> hoop_stretch;
   std::vector<double> hoop_stress;
 
+  // velocity_transfer = apic only: the particle's affine velocity field
+  // C_p, its velocity at x being v_p + C_p (x - x_p) (model.hpp).
+  std::vector<Mat2> affine_velocity;
+
   // Scene-specific: body force per unit mass b_p (eq. 1.71 uses m_p b_p).
   std::vector<Vec2> body_force;
 

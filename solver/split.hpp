@@ -5,7 +5,9 @@
 // of every cell line in between. A particle whose domain is longer than a
 // set length along r_i is replaced by its two halves along it:
 //   x = x_p -+ r_i / 2,   X = X_p -+ (l_i / 2) e_i,   l_i <- l_i / 2,
-//   m, V, V_0 halved;  v, F, stress unchanged.
+//   m, V, V_0 halved;  v, F, stress unchanged
+// (under APIC each half takes the parent's affine velocity field at its own
+// centre, v = v_p -+ C_p r_i / 2, and keeps C_p).
 // The map of the domain, x = x_p + F_p (X - X_p), is affine, so the halves
 // tile their parent exactly in both configurations and together carry its
 // mass, momentum, kinetic and strain energy, and first moment of mass.
@@ -37,6 +39,7 @@ inline std::size_t split_long_domains(Particles& P, double max_length) {
       P.resize(q + 1);
       P.half_size.push_back(l);
       if (!P.body_force.empty()) P.body_force.push_back(P.body_force[p]);
+      if (!P.affine_velocity.empty()) P.affine_velocity.push_back(P.affine_velocity[p]);
       // The halves: p keeps the minus side, q takes the plus side.
       P.half_size[p][axis] = P.half_size[q][axis] = 0.5 * l[axis];
       P.position[q] = P.position[p] + 0.5 * r;
@@ -44,6 +47,11 @@ inline std::size_t split_long_domains(Particles& P, double max_length) {
       P.reference_position[q] = P.reference_position[p] + reference_step;
       P.reference_position[p] -= reference_step;
       P.velocity[q] = P.velocity[p];
+      if (!P.affine_velocity.empty()) {
+        const Vec2 change = 0.5 * (P.affine_velocity[p] * r);
+        P.velocity[q] += change;
+        P.velocity[p] -= change;
+      }
       P.deformation_gradient[q] = P.deformation_gradient[p];
       P.stress[q] = P.stress[p];
       for (std::vector<double>* a : {&P.mass, &P.volume, &P.reference_volume}) {

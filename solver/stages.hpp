@@ -36,6 +36,10 @@ enum TransferField : unsigned {
   kInternalForce = 4u,  // -f_g^int = -sum_p V_p sigma_p G_gp, eq. 1.70 (in r-z also
                         // -sum_p V_p sigma_theta <S_g / r> e_r, the hoop stress)
   kBodyForce = 8u,      // f_g^body = sum_p m_p b_p S_gp
+  kAffineMomentum = 16u,  // with kMomentum (velocity_transfer = apic): each particle's momentum
+                          // as its affine field, sum_p S_gp m_p (v_p + C_p (x_g - x_p)); the
+                          // weights reproduce linear fields (sum_g S_gp x_g = x_p), so the
+                          // total momentum is still sum_p m_p v_p
 };
 
 struct NodeSums {
@@ -61,11 +65,14 @@ struct ParticleRange {
 
 // Sums the particle quantities selected by `Fields` onto the grid and stores
 // them in `g`, overwriting those node fields (the others are left as they are).
+// kAffineMomentum reads the node positions from `grid`.
 template <unsigned Fields, class Shape>
 void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& buffers,
-                       GridFields& g, ParticleRange range = {}) {
+                       GridFields& g, ParticleRange range = {}, const GridGeometry* grid = nullptr) {
   constexpr bool with_mass = Fields & kMass;
   constexpr bool with_momentum = Fields & kMomentum;
+  constexpr bool with_affine = Fields & kAffineMomentum;
+  static_assert(!with_affine || with_momentum, "the affine field is a part of the momentum");
   constexpr bool with_internal = Fields & kInternalForce;
   constexpr bool with_body = Fields & kBodyForce;
   constexpr bool with_force = with_internal || with_body;
@@ -94,7 +101,11 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
         NodeSums& node = sums[s.node[k]];
         const double w = s.weight[k];
         if constexpr (with_mass) node.mass += w * m;
-        if constexpr (with_momentum) {
+        if constexpr (with_affine) {
+          const Vec2 affine = momentum + m * (P.affine_velocity[p] * (grid->node_position(s.node[k]) - P.position[p]));
+          node.momentum_x += w * affine.x();
+          node.momentum_y += w * affine.y();
+        } else if constexpr (with_momentum) {
           node.momentum_x += w * momentum.x();
           node.momentum_y += w * momentum.y();
         }
@@ -207,6 +218,8 @@ enum ParticleUpdate : unsigned {
                       // is the exact gradient of that map, so F follows the particles.
                       // In r-z also the hoop rate v_r / r = sum_g <S_g / r> v_gr:
                       // F_theta <- (1 + dt v_r / r) F_theta, J_p = det(F_p) F_theta.
+  kAffine = 8u,       // with kVelocity (velocity_transfer = apic): v_p = sum_g S_gp v_g^L and
+                      // C_p = sum_g v_g^L (x) G_gp in place of the increment of eq. 1.76
 };
 
 // Every update reads the grid at the particle's position at the start of the
@@ -219,6 +232,8 @@ void grid_to_particles(const Shape& shape, const GridFields& g, Particles& P, do
   constexpr bool with_velocity = Updates & kVelocity;
   constexpr bool with_position = Updates & kPosition;
   constexpr bool with_deformation = Updates & kDeformation;
+  constexpr bool with_affine = Updates & kAffine;
+  static_assert(!with_affine || with_velocity, "the affine field is a velocity update");
   constexpr bool axisymmetric = Shape::geometry == Geometry::axisymmetric;
   if (position_out == nullptr) position_out = P.position.data();
   const std::size_t n = range.end(P);
@@ -229,13 +244,14 @@ void grid_to_particles(const Shape& shape, const GridFields& g, Particles& P, do
     for (std::size_t p = range.first; p < n; ++p) {
       shape.evaluate(p, s);
       Vec2 acceleration = Vec2::Zero(), velocity = Vec2::Zero();
-      Mat2 L = Mat2::Zero();
+      Mat2 L = Mat2::Zero(), C = Mat2::Zero();
       double hoop_rate = 0.0;
       for (int k = 0; k < s.count; ++k) {
         const int i = s.node[k];
-        if constexpr (with_velocity) acceleration += s.weight[k] * g.acceleration[i];
-        if constexpr (with_position) velocity += s.weight[k] * g.velocity[i];
+        if constexpr (with_velocity && !with_affine) acceleration += s.weight[k] * g.acceleration[i];
+        if constexpr (with_position || with_affine) velocity += s.weight[k] * g.velocity[i];
         if constexpr (with_deformation) L += g.velocity[i] * s.gradient[k].transpose();
+        if constexpr (with_affine && !with_deformation) C += g.velocity[i] * s.gradient[k].transpose();
         if constexpr (with_deformation && axisymmetric) hoop_rate += s.hoop[k] * g.velocity[i].x();
       }
       if constexpr (with_deformation) {
@@ -247,7 +263,12 @@ void grid_to_particles(const Shape& shape, const GridFields& g, Particles& P, do
         }
         P.volume[p] = J * P.reference_volume[p];
       }
-      if constexpr (with_velocity) P.velocity[p] += kick * acceleration;
+      if constexpr (with_affine) {
+        P.velocity[p] = velocity;
+        P.affine_velocity[p] = with_deformation ? L : C;
+      } else if constexpr (with_velocity) {
+        P.velocity[p] += kick * acceleration;
+      }
       if constexpr (with_position) position_out[p] = P.position[p] + dt * velocity;
     }
   }

@@ -513,6 +513,8 @@ std::unique_ptr<Stepper> make_static_stepper(Model model, const SolverOptions& o
     throw std::invalid_argument("bulk viscosity serves the explicit step only (a static step has no rate)");
   if (options.formulation != Formulation::updated)
     throw std::invalid_argument("the implicit static step has the updated formulation only");
+  if (options.velocity_transfer != VelocityTransfer::flip)
+    throw std::invalid_argument("velocity_transfer = apic serves the explicit step only (a static step has no velocities)");
   if (stages.second_material)
     throw std::invalid_argument("a second material serves the explicit step only");
   switch (options.method) {

@@ -55,6 +55,12 @@ std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_
        "cell crossing, and the linearized "
        "step of a stressed body stays symmetric (solver/shape/total_lagrangian.hpp)",
        -inf, inf, false, false, {"updated", "total"}},
+      {"velocity_transfer", KeyKind::text, std::string("flip"),
+       "how particles take their velocity back from the grid: flip (each keeps its own and adds the grid's "
+       "acceleration, eq. 1.76; what the grid cannot hold stays on the particles) or apic (each takes the grid's "
+       "velocity and its gradient C_p and maps back the affine field v_p + C_p (x - x_p): affine motion is kept, "
+       "the rest is damped every step; updated formulation, plane strain; solver/model.hpp)",
+       -inf, inf, false, false, {"flip", "apic"}},
       {"split_domains_beyond", KeyKind::real, 0.0,
        "cpdi only: after a step, a particle whose domain is longer than this many cells along one of its vectors is "
        "replaced by its two halves along it (0: never); keeps the corner interpolation of CPDI within a few cells "
@@ -116,6 +122,7 @@ SolverOptions solver_options(const Config& c) {
                  : d == "node-smoothed" ? Dilatation::node_smoothed
                                         : Dilatation::particle;
   o.formulation = c.text("formulation") == "total" ? Formulation::total : Formulation::updated;
+  o.velocity_transfer = c.text("velocity_transfer") == "apic" ? VelocityTransfer::apic : VelocityTransfer::flip;
   o.split_domains_beyond = c.real("split_domains_beyond");
   o.bulk_viscosity_linear = c.real("bulk_viscosity");
   o.bulk_viscosity_quadratic = c.real("bulk_viscosity_quadratic");
