@@ -244,14 +244,13 @@ void grid_to_particles(const Shape& shape, const GridFields& g, Particles& P, do
     for (std::size_t p = range.first; p < n; ++p) {
       shape.evaluate(p, s);
       Vec2 acceleration = Vec2::Zero(), velocity = Vec2::Zero();
-      Mat2 L = Mat2::Zero(), C = Mat2::Zero();
+      Mat2 L = Mat2::Zero();  // the velocity gradient, for F and for APIC's C_p
       double hoop_rate = 0.0;
       for (int k = 0; k < s.count; ++k) {
         const int i = s.node[k];
         if constexpr (with_velocity && !with_affine) acceleration += s.weight[k] * g.acceleration[i];
         if constexpr (with_position || with_affine) velocity += s.weight[k] * g.velocity[i];
-        if constexpr (with_deformation) L += g.velocity[i] * s.gradient[k].transpose();
-        if constexpr (with_affine && !with_deformation) C += g.velocity[i] * s.gradient[k].transpose();
+        if constexpr (with_deformation || with_affine) L += g.velocity[i] * s.gradient[k].transpose();
         if constexpr (with_deformation && axisymmetric) hoop_rate += s.hoop[k] * g.velocity[i].x();
       }
       if constexpr (with_deformation) {
@@ -265,7 +264,7 @@ void grid_to_particles(const Shape& shape, const GridFields& g, Particles& P, do
       }
       if constexpr (with_affine) {
         P.velocity[p] = velocity;
-        P.affine_velocity[p] = with_deformation ? L : C;
+        P.affine_velocity[p] = L;
       } else if constexpr (with_velocity) {
         P.velocity[p] += kick * acceleration;
       }
