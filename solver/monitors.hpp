@@ -54,7 +54,7 @@ Monitors monitor_particles(const Shape& shape, const Material& material, const P
   double kinetic = 0.0, strain = 0.0, min_J = m.min_J, max_J = 0.0, mach = 0.0, spin = 0.0;
   double distortion = 0.0;
   std::size_t near = 0;
-  constexpr bool has_domain = !std::is_same_v<Shape, LinearShapeT<Shape::geometry>>;
+  constexpr bool has_domain = Shape::has_domain;
 #pragma omp parallel for schedule(static) reduction(+ : kinetic, strain, near, spin) reduction(min : min_J) \
     reduction(max : max_J, mach, distortion)
   for (std::size_t p = begin; p < n; ++p) {

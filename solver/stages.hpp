@@ -414,7 +414,7 @@ void update_stress(const Material& material, Particles& P, std::size_t begin = 0
 // the hoop stress takes the same -q.
 // The length l_p is the particle's own thinnest width, the area of the
 // method's domain (shape.domain, as the monitors read it) over its longest
-// side (at most the cell size h; h for linear MPM, which has no domain). Eq. 1.66 suggests h; but a viscous stress is stable only to a
+// side (at most the cell size h; h for a method without one, linear and B-spline MPM). Eq. 1.66 suggests h; but a viscous stress is stable only to a
 // step that shrinks with the square of the width its gradients act across,
 // and a sheared CPDI domain grows thin: with l = h the ring at A = 1 on 256
 // cells, which completes without viscosity, stopped with nan at t = 0.315 s
@@ -429,7 +429,7 @@ ViscousStep add_bulk_viscosity(const Shape& shape, Particles& P, const std::vect
                                double wave_modulus, double h, double c0, double c1, double dt, std::size_t begin = 0,
                                std::size_t end = kAllParticles) {
   constexpr Geometry G = Shape::geometry;
-  constexpr bool has_domain = !std::is_same_v<Shape, LinearShapeT<G>>;
+  constexpr bool has_domain = Shape::has_domain;
   const std::size_t n = std::min(end, P.size());
   double dissipated = 0.0, max_ratio = 0.0;
 #pragma omp parallel for schedule(static) reduction(+ : dissipated) reduction(max : max_ratio)

@@ -10,7 +10,9 @@
 #include <vector>
 
 #include "solver/monitors.hpp"
+#include "solver/shape/bspline.hpp"
 #include "solver/shape/cpdi.hpp"
+#include "solver/shape/total_lagrangian.hpp"
 #include "solver/stages.hpp"
 #include "tools/app/scene.hpp"
 
@@ -100,6 +102,34 @@ TEST(Monitors, AngularMomentumOfARigidTurn) {
   const auto rz = mpmvv::monitor_particles(mpmvv::CpdiShapeT<mpmvv::Geometry::axisymmetric>::bind(grid, P), material,
                                            P, grid);
   EXPECT_TRUE(std::isnan(rz.angular_momentum));
+}
+
+// Domain distortion |s|^2 / (2 |det s|) is 1 for a square domain, and is not
+// defined for a point particle: linear and B-spline MPM, under either
+// formulation, report none (NaN) rather than the infinity of a zero area.
+TEST(Monitors, DistortionOfDomainsOnlyWherePointsHaveNone) {
+  const mpmvv::GridGeometry grid = mpmvv::GridGeometry::walled(mpmvv::Vec2(-2.0, -2.0), 0.5, 8, 8);
+  mpmvv::Particles P;
+  P.resize(3);
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    P.position[p] = P.reference_position[p] = mpmvv::Vec2(0.3 * double(p), -0.2 * double(p));
+    P.mass[p] = 1.0;
+    P.reference_volume[p] = P.volume[p] = 0.01;
+  }
+  P.half_size.assign(P.size(), mpmvv::Vec2(0.05, 0.05));
+  const mpmvv::NeoHookean material{577.0, 385.0};
+  EXPECT_NEAR(mpmvv::monitor_particles(mpmvv::CpdiShape::bind(grid, P), material, P, grid).max_distortion, 1.0,
+              1e-14);
+  EXPECT_NEAR(
+      mpmvv::monitor_particles(mpmvv::TotalLagrangianCpdiShape::bind(grid, P), material, P, grid).max_distortion,
+      1.0, 1e-14);
+  EXPECT_TRUE(std::isnan(
+      mpmvv::monitor_particles(mpmvv::TotalLagrangianLinearShape::bind(grid, P), material, P, grid).max_distortion));
+  EXPECT_TRUE(
+      std::isnan(mpmvv::monitor_particles(mpmvv::BsplineShape::bind(grid, P), material, P, grid).max_distortion));
+  EXPECT_TRUE(std::isnan(mpmvv::monitor_particles(mpmvv::TotalLagrangianShapeT<mpmvv::BsplineShape>::bind(grid, P),
+                                                  material, P, grid)
+                             .max_distortion));
 }
 
 // The cell-averaged dilatation (eqs. 1.82-1.84) gives every particle of a cell

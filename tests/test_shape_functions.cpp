@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "solver/particles.hpp"
+#include "solver/shape/bspline.hpp"
 #include "solver/shape/cpdi.hpp"
 #include "solver/shape/cpdi_exact.hpp"
 #include "solver/shape/gimp.hpp"
@@ -23,6 +24,7 @@
 
 namespace {
 
+using mpmvv::BsplineShape;
 using mpmvv::CpdiExactShape;
 using mpmvv::CpdiShape;
 using mpmvv::GimpShape;
@@ -67,7 +69,8 @@ Vec2 node_position(const GridGeometry& grid, int node) {
 
 // The distance, in cells, a particle centre must keep from a wall for
 // `inside` to accept it with F = I and l = h/4: linear MPM needs its cell,
-// uGIMP the node on each side of its nearest node, CPDI its corners.
+// uGIMP the node on each side of its nearest node, CPDI its corners, the
+// B-spline its nearest node (half a cell).
 template <class Shape>
 double wall_margin_in_cells();
 template <>
@@ -78,6 +81,8 @@ template <>
 double wall_margin_in_cells<CpdiShape>() { return 0.25; }
 template <>
 double wall_margin_in_cells<CpdiExactShape>() { return 0.25; }
+template <>
+double wall_margin_in_cells<BsplineShape>() { return 0.5; }  // its nearest node and one beyond it
 
 // Positions on and a hair either side of every place where a weight changes
 // formula, around node (3, 4) and the cell beyond it, plus the last accepted
@@ -169,7 +174,7 @@ void expect_shape_properties(const GridGeometry& grid, const Particles& P) {
 template <class Shape>
 class ShapeFunctionTest : public ::testing::Test {};
 
-using ShapeFamilies = ::testing::Types<LinearShape, GimpShape, CpdiShape, CpdiExactShape>;
+using ShapeFamilies = ::testing::Types<LinearShape, GimpShape, CpdiShape, CpdiExactShape, BsplineShape>;
 TYPED_TEST_SUITE(ShapeFunctionTest, ShapeFamilies);
 
 // (a)-(d) at random interior positions.
@@ -461,6 +466,98 @@ TEST(GimpWeight1D, ContinuousAtBreakpointsAndCompactlySupported) {
     EXPECT_EQ(mpmvv::gimp_weight_1d(d, h, l).weight, 0.0) << "d = " << d;
     EXPECT_EQ(mpmvv::gimp_weight_1d(d, h, l).derivative, 0.0) << "d = " << d;
   }
+}
+
+// ---------------------------------------------------------------- quadratic B-splines
+
+// The closed form of the uniform quadratic B-spline centred on a node, r the
+// distance from it in cells.
+double quadratic_bspline(double r) {
+  r = std::abs(r);
+  return r < 0.5 ? 0.75 - r * r : r < 1.5 ? 0.5 * (1.5 - r) * (1.5 - r) : 0.0;
+}
+
+// The node weights and gradients of a point, keyed by node.
+std::map<int, std::pair<double, Vec2>> bspline_stencil(const GridGeometry& grid, const Vec2& x) {
+  const Particles P = particles_at(grid, {x});
+  const BsplineShape shape = BsplineShape::bind(grid, P);
+  Stencil<BsplineShape::stencil_size> s;
+  shape.evaluate(0, s);
+  std::map<int, std::pair<double, Vec2>> out;
+  for (int k = 0; k < s.count; ++k) out[s.node[k]] = {s.weight[k], s.gradient[k]};
+  return out;
+}
+
+// Each listed weight is the tensor product of the closed-form B-spline at the
+// node, its gradient the centred difference of that weight, and every node
+// whose B-spline reaches the point is listed.
+TEST(BsplineShape, WeightsAreTheQuadraticBsplineAndGradientsItsDerivative) {
+  const GridGeometry grid = small_grid();
+  const double step = 1e-6 * grid.h;
+  double worst_gradient = 0.0;
+  for (const Vec2& x : random_interior_positions(grid, 200, 11)) {
+    const auto st = bspline_stencil(grid, x);
+    double reached = 0.0;
+    for (int node = 0; node < int(grid.node_count()); ++node) {
+      const Vec2 r = (x - node_position(grid, node)) / grid.h;
+      const double w = quadratic_bspline(r.x()) * quadratic_bspline(r.y());
+      if (w > 0.0) reached += 1.0;
+      const auto it = st.find(node);
+      if (it == st.end()) {
+        EXPECT_EQ(w, 0.0) << "node " << node << " is missing from the stencil";
+        continue;
+      }
+      EXPECT_NEAR(it->second.first, w, kRoundOff);
+      const Vec2 difference(
+          (quadratic_bspline(r.x() + step / grid.h) - quadratic_bspline(r.x() - step / grid.h)) *
+              quadratic_bspline(r.y()) / (2.0 * step),
+          quadratic_bspline(r.x()) *
+              (quadratic_bspline(r.y() + step / grid.h) - quadratic_bspline(r.y() - step / grid.h)) / (2.0 * step));
+      worst_gradient = std::max(worst_gradient, (it->second.second - difference).norm() * grid.h);
+    }
+    EXPECT_LE(reached, 9.0);
+  }
+  // The weights are piecewise quadratic with continuous derivatives: the
+  // centred difference is exact up to round-off 1e-16 / 1e-6 (and 1e-6 next
+  // to a breakpoint).
+  EXPECT_LT(worst_gradient, 1e-5);
+}
+
+// The basis is C1: where the nearest node changes (half a cell from a node)
+// and across a cell line, the weights and the gradients of every node are
+// the same on both sides, so a particle crossing a cell line sees no jump in
+// its gradients. The bilinear hats' gradients jump there by 1 / h.
+TEST(BsplineShape, WeightsAndGradientsAreContinuousWhereTheNearestNodeChanges) {
+  const GridGeometry grid = small_grid();
+  for (const Vec2& xi : {Vec2(3.5, 4.37), Vec2(3.61, 4.5), Vec2(3.5, 4.5), Vec2(3.0, 4.37)}) {
+    const Vec2 x = grid.origin + grid.h * xi;
+    const Vec2 hair = Vec2(1e-10, 1e-10) * grid.h;
+    auto below = bspline_stencil(grid, x - hair), above = bspline_stencil(grid, x + hair);
+    for (const auto& [node, wg] : below) {
+      const auto it = above.find(node);
+      const double w_above = it == above.end() ? 0.0 : it->second.first;
+      const Vec2 g_above = it == above.end() ? Vec2::Zero() : it->second.second;
+      EXPECT_NEAR(wg.first, w_above, 1e-9) << "node " << node;
+      EXPECT_LT((wg.second - g_above).norm() * grid.h, 1e-9) << "node " << node;
+    }
+    for (const auto& [node, wg] : above) {
+      if (!below.count(node)) {
+        EXPECT_NEAR(wg.first, 0.0, 1e-9) << "node " << node;
+      }
+    }
+  }
+  // The hats on the same cell line, for contrast: the gradient jumps.
+  const Vec2 x = grid.origin + grid.h * Vec2(3.0, 4.37), hair = Vec2(1e-10 * grid.h, 0.0);
+  Particles P = particles_at(grid, {x - hair, x + hair});
+  const LinearShape hats = LinearShape::bind(grid, P);
+  Stencil<LinearShape::stencil_size> a, b;
+  hats.evaluate(0, a);
+  hats.evaluate(1, b);
+  double jump = 0.0;
+  for (int k = 0; k < 4; ++k)
+    for (int m = 0; m < 4; ++m)
+      if (a.node[k] == b.node[m]) jump = std::max(jump, (a.gradient[k] - b.gradient[m]).norm() * grid.h);
+  EXPECT_GT(jump, 0.5);
 }
 
 }  // namespace

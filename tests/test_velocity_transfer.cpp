@@ -17,6 +17,7 @@
 
 #include "solver/explicit_stepper.hpp"
 #include "solver/parallel.hpp"
+#include "solver/shape/bspline.hpp"
 #include "solver/shape/cpdi.hpp"
 #include "solver/shape/gimp.hpp"
 #include "solver/shape/linear.hpp"
@@ -64,7 +65,7 @@ Model jittered_block(const Mat2& F) {
 
 template <class Shape>
 class VelocityTransferTest : public ::testing::Test {};
-using Shapes = ::testing::Types<mpmvv::LinearShape, mpmvv::GimpShape, mpmvv::CpdiShape>;
+using Shapes = ::testing::Types<mpmvv::LinearShape, mpmvv::GimpShape, mpmvv::CpdiShape, mpmvv::BsplineShape>;
 TYPED_TEST_SUITE(VelocityTransferTest, Shapes);
 
 constexpr unsigned kAffineMap = mpmvv::kMass | mpmvv::kMomentum | mpmvv::kAffineMomentum;

@@ -104,6 +104,7 @@ struct CpdiExactShapeT {
   static constexpr Geometry geometry = G;
   static constexpr bool reads_deformation_gradient = true;
   static constexpr bool gradients_beyond_grid_basis = false;  // exact averages of the grid basis
+  static constexpr bool has_domain = true;
 
   const GridGeometry* grid;
   const Vec2* position;

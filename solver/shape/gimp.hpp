@@ -73,6 +73,7 @@ struct GimpShapeT {
   static constexpr Geometry geometry = G;
   static constexpr bool reads_deformation_gradient = false;
   static constexpr bool gradients_beyond_grid_basis = false;  // averages of the grid basis
+  static constexpr bool has_domain = true;
 
   const GridGeometry* grid;
   const Vec2* position;

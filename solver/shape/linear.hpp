@@ -60,6 +60,7 @@ struct LinearShapeT {
   static constexpr Geometry geometry = G;
   static constexpr bool reads_deformation_gradient = false;
   static constexpr bool gradients_beyond_grid_basis = false;  // the grid basis itself
+  static constexpr bool has_domain = false;                   // a point (eq. 1.88)
 
   const GridGeometry* grid;
   const Vec2* position;

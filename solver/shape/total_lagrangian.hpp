@@ -26,7 +26,9 @@
 // literature), or uGIMP, whose square reference domains tile the body, or
 // CPDI over the same squares (corner interpolation of the grid
 // basis, eq. 1.95 with F = I), or exact CPDI over each particle's exact
-// reference outline (a cut piece of a curved body keeps its true shape): the
+// reference outline (a cut piece of a curved body keeps its true shape), or
+// the grid's quadratic B-splines at X_p (shape/bspline.hpp; a point, like the
+// hat, with a C1 basis one order richer): the
 // domains never deform, so CPDI's large-shear trouble (stretched domains,
 // gradients beyond the grid basis) never arises, and the basis is fixed for
 // the run.
@@ -54,6 +56,7 @@ struct TotalLagrangianShapeT {
   static constexpr bool reads_deformation_gradient = true;
   static constexpr bool gradients_beyond_grid_basis = false;  // G0 is the reference basis's own
   static constexpr bool total_lagrangian = true;
+  static constexpr bool has_domain = Reference::has_domain;
 
   Reference reference;             // the method's basis at X_p
   const Mat2* deformation_gradient;
@@ -83,6 +86,11 @@ struct TotalLagrangianShapeT {
   // The reference point lies where it always did; the run stops on the
   // state alone (J, NaN), which the health scan checks.
   bool inside(std::size_t p) const { return reference.inside(p); }
+  bool clear_of_walls(std::size_t p) const
+    requires requires(const Reference& r, std::size_t q) { r.clear_of_walls(q); }
+  {
+    return reference.clear_of_walls(p);
+  }
 
   // The current image of the reference domain, F_p times its half-vectors.
   Mat2 domain(std::size_t p) const { return deformation_gradient[p] * reference.domain(p); }

@@ -34,8 +34,9 @@ std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_
   const double inf = std::numeric_limits<double>::infinity();
   return {
       {"method", KeyKind::text, std::string("cpdi"), "shape functions: linear (standard MPM), gimp (uGIMP), cpdi, cpdi-exact (CPDI domains "
-       "integrated exactly over the cells they cross)",
-       -inf, inf, false, false, {"linear", "gimp", "cpdi", "cpdi-exact"}},
+       "integrated exactly over the cells they cross), bspline (point particles on quadratic B-splines, plane strain, "
+       "explicit)",
+       -inf, inf, false, false, {"linear", "gimp", "cpdi", "cpdi-exact", "bspline"}},
       {"scheme", KeyKind::text, std::string("usl"), "stress update: usl (update stress last), usf (first), musl (modified USL)",
        -inf, inf, false, false, {"usl", "usf", "musl"}},
       {"time_integration", KeyKind::text, std::string("central-difference"),
@@ -114,6 +115,7 @@ SolverOptions solver_options(const Config& c) {
   o.method = m == "linear"   ? Method::linear
              : m == "gimp"   ? Method::gimp
              : m == "cpdi"   ? Method::cpdi
+             : m == "bspline" ? Method::bspline
                              : Method::cpdi_exact;
   const std::string& s = c.text("scheme");
   o.scheme = s == "usf" ? Scheme::usf : s == "musl" ? Scheme::musl : Scheme::usl;
