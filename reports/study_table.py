@@ -16,7 +16,7 @@ from collections import defaultdict
 
 import h5py
 
-METHOD_ORDER = {"linear": 0, "gimp": 1, "cpdi": 2, "cpdi-exact": 3, "bspline": 4}
+METHOD_ORDER = {"linear": 0, "gimp": 1, "cpdi": 2, "cpdi-exact": 3, "bspline": 4, "bspline-cubic": 5}
 
 
 def text(value):

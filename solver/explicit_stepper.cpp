@@ -27,6 +27,7 @@ const char* to_string(Method m) {
     case Method::cpdi: return "cpdi";
     case Method::cpdi_exact: return "cpdi-exact";
     case Method::bspline: return "bspline";
+    case Method::bspline_cubic: return "bspline-cubic";
   }
   return "?";
 }
@@ -221,8 +222,9 @@ class ExplicitStepper final : public Stepper {
         return {"outside grid", fmt::format("the particle at ({:.6g}, {:.6g}) has crossed a wall", x.x(), x.y())};
       if constexpr (requires { shape.clear_of_walls(p); })
         if (!shape.clear_of_walls(p))
-          return {"outside grid", fmt::format("the particle at ({:.6g}, {:.6g}) has come within half a cell of a wall, "
-                                              "where its B-spline support reaches the mirrored ghost nodes",
+          return {"outside grid", fmt::format("the particle at ({:.6g}, {:.6g}) has come closer to a wall than its "
+                                              "B-spline support allows (half a cell quadratic, a cell cubic: it "
+                                              "would reach the mirrored ghost nodes)",
                                               x.x(), x.y())};
       if constexpr (requires { shape.within_stencil(p); })
         if (!shape.within_stencil(p))
@@ -531,6 +533,9 @@ std::unique_ptr<Stepper> make_for_geometry(Model model, const SolverOptions& o, 
           return make_for_shape<TotalLagrangianLinearShape>(std::move(model), o, material, std::move(stages));
         case Method::bspline:
           return make_for_shape<TotalLagrangianShapeT<BsplineShape>>(std::move(model), o, material, std::move(stages));
+        case Method::bspline_cubic:
+          return make_for_shape<TotalLagrangianShapeT<CubicBsplineShape>>(std::move(model), o, material,
+                                                                          std::move(stages));
       }
   switch (o.method) {
     case Method::linear: return make_for_shape<LinearShapeT<G>>(std::move(model), o, material, std::move(stages));
@@ -539,10 +544,14 @@ std::unique_ptr<Stepper> make_for_geometry(Model model, const SolverOptions& o, 
     case Method::cpdi_exact:
       return make_for_shape<CpdiExactShapeT<G>>(std::move(model), o, material, std::move(stages));
     case Method::bspline:
-      if constexpr (G == Geometry::plane_strain)
-        return make_for_shape<BsplineShape>(std::move(model), o, material, std::move(stages));
-      else
-        throw std::logic_error("method bspline in r-z (make_stepper refuses it)");
+    case Method::bspline_cubic:
+      if constexpr (G == Geometry::plane_strain) {
+        if (o.method == Method::bspline)
+          return make_for_shape<BsplineShape>(std::move(model), o, material, std::move(stages));
+        return make_for_shape<CubicBsplineShape>(std::move(model), o, material, std::move(stages));
+      } else {
+        throw std::logic_error("B-splines in r-z (make_stepper refuses them)");
+      }
   }
   throw std::logic_error("unknown method");
 }
@@ -580,9 +589,10 @@ std::unique_ptr<Stepper> make_stepper(Model model, const SolverOptions& options,
   if (!(stages.damping >= 0.0)) throw std::invalid_argument("damping must be zero or positive");
   if (!(options.split_domains_beyond >= 0.0))
     throw std::invalid_argument("split_domains_beyond must be zero (never) or a positive number of cells");
-  if (options.method == Method::bspline && options.geometry != Geometry::plane_strain)
-    throw std::invalid_argument("method bspline is plane strain only: in r-z a particle near the axis would weigh "
-                                "nodes at r < 0");
+  const bool bspline = options.method == Method::bspline || options.method == Method::bspline_cubic;
+  if (bspline && options.geometry != Geometry::plane_strain)
+    throw std::invalid_argument(fmt::format("method {} is plane strain only: in r-z a particle near the axis would "
+                                            "weigh nodes at r < 0", to_string(options.method)));
   if (options.split_domains_beyond > 0.0) {
     if (options.method != Method::cpdi) throw std::invalid_argument("split_domains_beyond is for method cpdi only");
     if (options.geometry != Geometry::plane_strain)
@@ -636,19 +646,25 @@ std::unique_ptr<Stepper> make_stepper(Model model, const SolverOptions& options,
                                                 model.grid.node_count()));
   }
   if (n == 0) throw std::invalid_argument("the scene seeded no particles");
-  if (options.method != Method::linear && options.method != Method::bspline && model.particles.half_size.size() != n)
+  if (options.method != Method::linear && !bspline && model.particles.half_size.size() != n)
     throw std::invalid_argument(fmt::format("method {} needs a particle domain (half_size) for every particle",
                                             to_string(options.method)));
   check_domain_outlines(model.particles, options.method);
-  if (options.method == Method::bspline) {
-    const BsplineShape shape = BsplineShape::bind(model.grid, model.particles);
-    for (std::size_t p = 0; p < n; ++p)
-      if (!shape.clear_of_walls(p))
-        throw std::invalid_argument(fmt::format(
-            "method bspline: the particle at ({:.6g}, {:.6g}) lies within half a cell (h = {:.6g}) of a wall, where "
-            "its support would reach the mirrored ghost nodes (shape/bspline.hpp); keep the body half a cell clear "
-            "of the walls, or take another method",
-            model.particles.position[p].x(), model.particles.position[p].y(), model.grid.h));
+  if (bspline) {
+    auto check = [&](const auto shape) {
+      for (std::size_t p = 0; p < n; ++p)
+        if (!shape.clear_of_walls(p))
+          throw std::invalid_argument(fmt::format(
+              "method {}: the particle at ({:.6g}, {:.6g}) lies within {:g} cells (h = {:.6g}) of a wall, where its "
+              "support would reach the mirrored ghost nodes (shape/bspline.hpp); keep the body that far from the "
+              "walls, or take another method",
+              to_string(options.method), model.particles.position[p].x(), model.particles.position[p].y(),
+              shape.wall_clearance, model.grid.h));
+    };
+    if (options.method == Method::bspline)
+      check(BsplineShape::bind(model.grid, model.particles));
+    else
+      check(CubicBsplineShape::bind(model.grid, model.particles));
   }
   if (options.geometry == Geometry::axisymmetric) {
     if (model.particles.hoop_stretch.size() != n || model.particles.hoop_stress.size() != n)

@@ -17,7 +17,7 @@
 
 namespace mpmvv {
 
-enum class Method { linear, gimp, cpdi, cpdi_exact, bspline };
+enum class Method { linear, gimp, cpdi, cpdi_exact, bspline, bspline_cubic };
 enum class Scheme { usl, usf, musl };
 // What each particle's J is after a deformation update: its own det F, its
 // cell's mean (average_cell_dilatation, eqs. 1.82-1.84), or the mean its

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #ifdef MPMVV_HAVE_FFTW
@@ -418,21 +419,27 @@ TEST(Contact, TwoBlocksCollideWithoutFrictionOrInterpenetration) {
   EXPECT_LT((1.0 - kept16) / (1.0 - kept8), 0.6);
 }
 
-// The B-spline support reaches one node past a wall when a particle comes
-// within half a cell of it, where the mirror walls would drop the particle's
-// share on the ghost node (shape/bspline.hpp). A body half a cell clear of the
-// walls runs; one closer is refused by name before the run starts.
-TEST(Walls, BsplineKeepsItsParticlesHalfACellClearOfTheWalls) {
-  mpmvv::SolverOptions options{Method::bspline, Scheme::usl};
-  EXPECT_NO_THROW(mpmvv::make_stepper(block(Method::bspline), options, kSolid, nullptr));
-  Model near = block(Method::bspline);
-  near.particles.position[0] = near.grid.wall_lower() + Vec2(0.4, 4.25) * near.grid.h;
-  try {
-    mpmvv::make_stepper(near, options, kSolid, nullptr);
-    ADD_FAILURE() << "a B-spline particle 0.4 cells from a wall was accepted";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("lies within half a cell"), std::string::npos) << e.what();
+// The B-spline support reaches a node past a wall when a particle comes
+// within half a cell (quadratic) or a cell (cubic) of it, where the mirror
+// walls would drop the particle's share on the ghost node
+// (shape/bspline.hpp). A body that far clear of the walls runs; one closer is
+// refused by name before the run starts.
+TEST(Walls, BsplinesKeepTheirParticlesClearOfTheWalls) {
+  for (const auto& [method, clearance] : {std::pair{Method::bspline, 0.5}, std::pair{Method::bspline_cubic, 1.0}}) {
+    SCOPED_TRACE(mpmvv::to_string(method));
+    const mpmvv::SolverOptions options{method, Scheme::usl};
+    EXPECT_NO_THROW(mpmvv::make_stepper(block(method), options, kSolid, nullptr));
+    Model near = block(method);
+    near.particles.position[0] = near.grid.wall_lower() + Vec2(clearance - 0.1, 4.25) * near.grid.h;
+    try {
+      mpmvv::make_stepper(near, options, kSolid, nullptr);
+      ADD_FAILURE() << "a particle " << clearance - 0.1 << " cells from a wall was accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("of a wall, where its support would reach the mirrored ghost nodes"),
+                std::string::npos)
+          << e.what();
+    }
+    near.particles.position[0] = near.grid.wall_lower() + Vec2(clearance, 4.25) * near.grid.h;
+    EXPECT_NO_THROW(mpmvv::make_stepper(near, options, kSolid, nullptr));
   }
-  near.particles.position[0] = near.grid.wall_lower() + Vec2(0.5, 4.25) * near.grid.h;
-  EXPECT_NO_THROW(mpmvv::make_stepper(near, options, kSolid, nullptr));
 }

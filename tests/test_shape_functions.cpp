@@ -25,6 +25,7 @@
 namespace {
 
 using mpmvv::BsplineShape;
+using mpmvv::CubicBsplineShape;
 using mpmvv::CpdiExactShape;
 using mpmvv::CpdiShape;
 using mpmvv::GimpShape;
@@ -70,7 +71,7 @@ Vec2 node_position(const GridGeometry& grid, int node) {
 // The distance, in cells, a particle centre must keep from a wall for
 // `inside` to accept it with F = I and l = h/4: linear MPM needs its cell,
 // uGIMP the node on each side of its nearest node, CPDI its corners, the
-// B-spline its nearest node (half a cell).
+// B-splines the node beyond the wall (half a cell quadratic, one cubic).
 template <class Shape>
 double wall_margin_in_cells();
 template <>
@@ -82,7 +83,9 @@ double wall_margin_in_cells<CpdiShape>() { return 0.25; }
 template <>
 double wall_margin_in_cells<CpdiExactShape>() { return 0.25; }
 template <>
-double wall_margin_in_cells<BsplineShape>() { return 0.5; }  // its nearest node and one beyond it
+double wall_margin_in_cells<BsplineShape>() { return 0.5; }  // the node beyond the wall would weigh it
+template <>
+double wall_margin_in_cells<CubicBsplineShape>() { return 1.0; }
 
 // Positions on and a hair either side of every place where a weight changes
 // formula, around node (3, 4) and the cell beyond it, plus the last accepted
@@ -174,7 +177,8 @@ void expect_shape_properties(const GridGeometry& grid, const Particles& P) {
 template <class Shape>
 class ShapeFunctionTest : public ::testing::Test {};
 
-using ShapeFamilies = ::testing::Types<LinearShape, GimpShape, CpdiShape, CpdiExactShape, BsplineShape>;
+using ShapeFamilies =
+    ::testing::Types<LinearShape, GimpShape, CpdiShape, CpdiExactShape, BsplineShape, CubicBsplineShape>;
 TYPED_TEST_SUITE(ShapeFunctionTest, ShapeFamilies);
 
 // (a)-(d) at random interior positions.
@@ -468,71 +472,77 @@ TEST(GimpWeight1D, ContinuousAtBreakpointsAndCompactlySupported) {
   }
 }
 
-// ---------------------------------------------------------------- quadratic B-splines
+// ---------------------------------------------------------------- B-splines
 
-// The closed form of the uniform quadratic B-spline centred on a node, r the
-// distance from it in cells.
-double quadratic_bspline(double r) {
+// The closed forms of the uniform quadratic and cubic B-splines centred on a
+// node, r the distance from it in cells (written from the recursion's
+// pieces, independently of shape/bspline.hpp).
+double closed_form_bspline(int degree, double r) {
   r = std::abs(r);
-  return r < 0.5 ? 0.75 - r * r : r < 1.5 ? 0.5 * (1.5 - r) * (1.5 - r) : 0.0;
+  if (degree == 2) return r < 0.5 ? 0.75 - r * r : r < 1.5 ? 0.5 * (1.5 - r) * (1.5 - r) : 0.0;
+  return r < 1.0 ? (3.0 * r * r * r - 6.0 * r * r + 4.0) / 6.0 : r < 2.0 ? (2.0 - r) * (2.0 - r) * (2.0 - r) / 6.0 : 0.0;
 }
 
 // The node weights and gradients of a point, keyed by node.
-std::map<int, std::pair<double, Vec2>> bspline_stencil(const GridGeometry& grid, const Vec2& x) {
+template <class Shape>
+std::map<int, std::pair<double, Vec2>> stencil_at(const GridGeometry& grid, const Vec2& x) {
   const Particles P = particles_at(grid, {x});
-  const BsplineShape shape = BsplineShape::bind(grid, P);
-  Stencil<BsplineShape::stencil_size> s;
+  const Shape shape = Shape::bind(grid, P);
+  Stencil<Shape::stencil_size> s;
   shape.evaluate(0, s);
   std::map<int, std::pair<double, Vec2>> out;
   for (int k = 0; k < s.count; ++k) out[s.node[k]] = {s.weight[k], s.gradient[k]};
   return out;
 }
 
+template <class Shape>
+class BsplineTest : public ::testing::Test {};
+using Bsplines = ::testing::Types<BsplineShape, CubicBsplineShape>;
+TYPED_TEST_SUITE(BsplineTest, Bsplines);
+
 // Each listed weight is the tensor product of the closed-form B-spline at the
 // node, its gradient the centred difference of that weight, and every node
 // whose B-spline reaches the point is listed.
-TEST(BsplineShape, WeightsAreTheQuadraticBsplineAndGradientsItsDerivative) {
+TYPED_TEST(BsplineTest, WeightsAreTheClosedFormAndGradientsItsDerivative) {
+  const int degree = TypeParam::width - 1;
+  auto N = [degree](double r) { return closed_form_bspline(degree, r); };
   const GridGeometry grid = small_grid();
-  const double step = 1e-6 * grid.h;
+  const double step = 1e-6;  // in cells
   double worst_gradient = 0.0;
   for (const Vec2& x : random_interior_positions(grid, 200, 11)) {
-    const auto st = bspline_stencil(grid, x);
-    double reached = 0.0;
+    const auto st = stencil_at<TypeParam>(grid, x);
+    int reached = 0;
     for (int node = 0; node < int(grid.node_count()); ++node) {
       const Vec2 r = (x - node_position(grid, node)) / grid.h;
-      const double w = quadratic_bspline(r.x()) * quadratic_bspline(r.y());
-      if (w > 0.0) reached += 1.0;
+      const double w = N(r.x()) * N(r.y());
+      if (w > 0.0) ++reached;
       const auto it = st.find(node);
       if (it == st.end()) {
         EXPECT_EQ(w, 0.0) << "node " << node << " is missing from the stencil";
         continue;
       }
       EXPECT_NEAR(it->second.first, w, kRoundOff);
-      const Vec2 difference(
-          (quadratic_bspline(r.x() + step / grid.h) - quadratic_bspline(r.x() - step / grid.h)) *
-              quadratic_bspline(r.y()) / (2.0 * step),
-          quadratic_bspline(r.x()) *
-              (quadratic_bspline(r.y() + step / grid.h) - quadratic_bspline(r.y() - step / grid.h)) / (2.0 * step));
-      worst_gradient = std::max(worst_gradient, (it->second.second - difference).norm() * grid.h);
+      const Vec2 difference((N(r.x() + step) - N(r.x() - step)) * N(r.y()),
+                            N(r.x()) * (N(r.y() + step) - N(r.y() - step)));
+      worst_gradient = std::max(worst_gradient, (it->second.second * grid.h - difference / (2.0 * step)).norm());
     }
-    EXPECT_LE(reached, 9.0);
+    EXPECT_LE(reached, TypeParam::stencil_size);
   }
-  // The weights are piecewise quadratic with continuous derivatives: the
-  // centred difference is exact up to round-off 1e-16 / 1e-6 (and 1e-6 next
-  // to a breakpoint).
+  // Piecewise polynomials with continuous derivatives: the centred difference
+  // is exact up to round-off 1e-16 / 1e-6 and a curvature term of 1e-6.
   EXPECT_LT(worst_gradient, 1e-5);
 }
 
-// The basis is C1: where the nearest node changes (half a cell from a node)
-// and across a cell line, the weights and the gradients of every node are
-// the same on both sides, so a particle crossing a cell line sees no jump in
-// its gradients. The bilinear hats' gradients jump there by 1 / h.
-TEST(BsplineShape, WeightsAndGradientsAreContinuousWhereTheNearestNodeChanges) {
+// The basis is C1 at least: where the set of covering nodes changes and
+// across a cell line, the weights and the gradients of every node are the
+// same on both sides, so a particle crossing a cell line sees no jump in its
+// gradients. The bilinear hats' gradients jump there by 1 / h.
+TYPED_TEST(BsplineTest, WeightsAndGradientsAreContinuousWhereTheStencilChanges) {
   const GridGeometry grid = small_grid();
-  for (const Vec2& xi : {Vec2(3.5, 4.37), Vec2(3.61, 4.5), Vec2(3.5, 4.5), Vec2(3.0, 4.37)}) {
+  for (const Vec2& xi : {Vec2(3.5, 4.37), Vec2(3.61, 4.5), Vec2(3.5, 4.5), Vec2(3.0, 4.37), Vec2(3.0, 4.0)}) {
     const Vec2 x = grid.origin + grid.h * xi;
     const Vec2 hair = Vec2(1e-10, 1e-10) * grid.h;
-    auto below = bspline_stencil(grid, x - hair), above = bspline_stencil(grid, x + hair);
+    auto below = stencil_at<TypeParam>(grid, x - hair), above = stencil_at<TypeParam>(grid, x + hair);
     for (const auto& [node, wg] : below) {
       const auto it = above.find(node);
       const double w_above = it == above.end() ? 0.0 : it->second.first;
@@ -546,7 +556,12 @@ TEST(BsplineShape, WeightsAndGradientsAreContinuousWhereTheNearestNodeChanges) {
       }
     }
   }
-  // The hats on the same cell line, for contrast: the gradient jumps.
+}
+
+// The same comparison on the bilinear hats finds their jump on a cell line:
+// the check above can fail.
+TEST(BsplineShape, HatGradientsJumpWhereTheSplinesDoNot) {
+  const GridGeometry grid = small_grid();
   const Vec2 x = grid.origin + grid.h * Vec2(3.0, 4.37), hair = Vec2(1e-10 * grid.h, 0.0);
   Particles P = particles_at(grid, {x - hair, x + hair});
   const LinearShape hats = LinearShape::bind(grid, P);

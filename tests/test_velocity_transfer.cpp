@@ -65,7 +65,8 @@ Model jittered_block(const Mat2& F) {
 
 template <class Shape>
 class VelocityTransferTest : public ::testing::Test {};
-using Shapes = ::testing::Types<mpmvv::LinearShape, mpmvv::GimpShape, mpmvv::CpdiShape, mpmvv::BsplineShape>;
+using Shapes = ::testing::Types<mpmvv::LinearShape, mpmvv::GimpShape, mpmvv::CpdiShape, mpmvv::BsplineShape,
+                                mpmvv::CubicBsplineShape>;
 TYPED_TEST_SUITE(VelocityTransferTest, Shapes);
 
 constexpr unsigned kAffineMap = mpmvv::kMass | mpmvv::kMomentum | mpmvv::kAffineMomentum;

@@ -501,7 +501,8 @@ std::unique_ptr<Stepper> make_static_stepper(Model model, const SolverOptions& o
   if (options.geometry != Geometry::plane_strain)
     throw std::invalid_argument("the implicit static step is plane strain only");
   if (model.particles.size() == 0) throw std::invalid_argument("the scene seeded no particles");
-  if (options.method == Method::bspline) throw std::invalid_argument("method bspline serves the explicit step only");
+  if (options.method == Method::bspline || options.method == Method::bspline_cubic)
+    throw std::invalid_argument(fmt::format("method {} serves the explicit step only", to_string(options.method)));
   if (options.method != Method::linear && model.particles.half_size.size() != model.particles.size())
     throw std::invalid_argument(fmt::format("method {} needs a particle domain (half_size) for every particle",
                                             to_string(options.method)));
@@ -523,7 +524,8 @@ std::unique_ptr<Stepper> make_static_stepper(Model model, const SolverOptions& o
     case Method::gimp: return make_for_shape<GimpShapeT<Geometry::plane_strain>>(std::move(model), material, std::move(stages), o);
     case Method::cpdi: return make_for_shape<CpdiShape>(std::move(model), material, std::move(stages), o);
     case Method::cpdi_exact: return make_for_shape<CpdiExactShape>(std::move(model), material, std::move(stages), o);
-    case Method::bspline: break;  // refused above
+    case Method::bspline:
+    case Method::bspline_cubic: break;  // refused above
   }
   throw std::logic_error("unknown method");
 }

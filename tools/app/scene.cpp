@@ -34,9 +34,9 @@ std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_
   const double inf = std::numeric_limits<double>::infinity();
   return {
       {"method", KeyKind::text, std::string("cpdi"), "shape functions: linear (standard MPM), gimp (uGIMP), cpdi, cpdi-exact (CPDI domains "
-       "integrated exactly over the cells they cross), bspline (point particles on quadratic B-splines, plane strain, "
-       "explicit)",
-       -inf, inf, false, false, {"linear", "gimp", "cpdi", "cpdi-exact", "bspline"}},
+       "integrated exactly over the cells they cross), bspline and bspline-cubic (point particles on the grid's "
+       "quadratic or cubic B-splines; plane strain, explicit, the body half a cell or a cell clear of the walls)",
+       -inf, inf, false, false, {"linear", "gimp", "cpdi", "cpdi-exact", "bspline", "bspline-cubic"}},
       {"scheme", KeyKind::text, std::string("usl"), "stress update: usl (update stress last), usf (first), musl (modified USL)",
        -inf, inf, false, false, {"usl", "usf", "musl"}},
       {"time_integration", KeyKind::text, std::string("central-difference"),
@@ -116,6 +116,7 @@ SolverOptions solver_options(const Config& c) {
              : m == "gimp"   ? Method::gimp
              : m == "cpdi"   ? Method::cpdi
              : m == "bspline" ? Method::bspline
+             : m == "bspline-cubic" ? Method::bspline_cubic
                              : Method::cpdi_exact;
   const std::string& s = c.text("scheme");
   o.scheme = s == "usf" ? Scheme::usf : s == "musl" ? Scheme::musl : Scheme::usl;
