@@ -55,6 +55,15 @@ inline std::vector<double> apply_constraints(const std::vector<NodeConstraint>& 
   return reactions;
 }
 
+// Two flags per grid node (x, y): 1 where a constraint prescribes the component.
+inline std::vector<unsigned char> prescribed_components(std::size_t nodes,
+                                                        const std::vector<NodeConstraint>& constraints) {
+  std::vector<unsigned char> fixed(2 * nodes, 0);
+  for (const NodeConstraint& c : constraints)
+    for (std::size_t node : c.nodes) fixed[2 * node + std::size_t(c.axis)] = 1;
+  return fixed;
+}
+
 // ---------------------------------------------------------------- tractions
 
 // A dead load on boundary particles (eq. 1.64, f_g^ext = sum_p f_p S_gp): each
@@ -137,6 +146,9 @@ inline double damping_power(const GridGeometry& grid, const GridFields& g, doubl
 struct SceneStages {
   std::shared_ptr<BodyForce> body_force;    // a body force, or tractions on boundary particles
   std::vector<NodeConstraint> constraints;  // prescribed motion of grid nodes
+  // Points where the grid motion, read with the method's grid basis, is held
+  // at rest (rest_points.hpp): a boundary the nodes do not lie on.
+  std::vector<Vec2> rest_points;
   double damping = 0.0;                     // zeta of eq. 1.65 [1/s]; 0: no damping
   std::optional<RigidBody> contact;         // a rigid master in frictionless contact (contact.hpp)
   // Two deformable bodies in frictionless contact on the grid: particles

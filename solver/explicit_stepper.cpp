@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 
+#include "rest_points.hpp"
 #include "split.hpp"
 #include "shape/cpdi.hpp"
 #include "shape/cpdi_exact.hpp"
@@ -66,6 +67,11 @@ class ExplicitStepper final : public Stepper {
         second_material_from_(stages.second_material_from),
         body_force_(std::move(stages.body_force)),
         constraints_(std::move(stages.constraints)),
+        rest_(stages.rest_points.empty()
+                  ? std::nullopt
+                  : std::optional<RestPoints>(std::in_place,
+                        basis_rows<typename Shape::GridBasis>(model_.grid, stages.rest_points),
+                        prescribed_components(model_.grid.node_count(), constraints_))),
         damping_(stages.damping),
         contact_(std::move(stages.contact)),
         second_(stages.second_body) {
@@ -79,11 +85,7 @@ class ExplicitStepper final : public Stepper {
     // The affine part starts at zero: the first map is FLIP's.
     if (apic_) model_.particles.affine_velocity.assign(model_.particles.size(), Mat2::Zero());
     if (dilatation_ != Dilatation::particle) volume_sums_.resize(std::size_t(max_threads()));
-    if (damping_ > 0.0) {
-      fixed_components_.assign(2 * model_.grid.node_count(), 0);
-      for (const NodeConstraint& c : constraints_)
-        for (std::size_t node : c.nodes) fixed_components_[2 * node + std::size_t(c.axis)] = 1;
-    }
+    if (damping_ > 0.0) fixed_components_ = prescribed_components(model_.grid.node_count(), constraints_);
     if (second_ > 0) {
       fields_b_.resize(model_.grid.node_count());
       gradient_a_.assign(model_.grid.node_count(), Vec2::Zero());
@@ -309,6 +311,7 @@ class ExplicitStepper final : public Stepper {
     grid_velocity_from_momentum(fields_);
     apply_walls(model_.grid, fields_);
     if (!constraints_.empty()) apply_constraints(constraints_, t, dt, kick, fields_);
+    if (rest_) rest_->apply(fields_, kick);
     remember_volumes();
     grid_to_particles<kDeformation, Shape>(shape, fields_, P, dt, kick);
     update_stress_of_particles(dt);
@@ -337,6 +340,7 @@ class ExplicitStepper final : public Stepper {
     grid_velocity_from_momentum(fields_);
     apply_walls(model_.grid, fields_);
     if (!constraints_.empty()) apply_constraints(constraints_, t, dt, kick, fields_);
+    if (rest_) rest_->apply(fields_, kick);
     remember_volumes();
     grid_to_particles<kDeformation, Shape>(shape, fields_, P, dt, kick);
     P.position.swap(next_position_);
@@ -427,6 +431,7 @@ class ExplicitStepper final : public Stepper {
       reactions_ = apply_constraints(constraints_, t, dt, kick, fields_);
       book_constraint_work(t, dt);
     }
+    if (rest_) rest_->apply(fields_, kick);
     if (contact_) {
       apply_rigid_contact(*contact_, shape, model_.particles, model_.grid, fields_, t, dt, kick, contact_scratch_,
                           contact_forces_);
@@ -484,6 +489,7 @@ class ExplicitStepper final : public Stepper {
   std::size_t second_material_from_;
   std::shared_ptr<BodyForce> body_force_;
   std::vector<NodeConstraint> constraints_;
+  std::optional<RestPoints> rest_;  // the scene's rest points (rest_points.hpp); absent without them
   double damping_;
   std::vector<unsigned char> fixed_components_;  // with damping: the components constraints prescribe
   std::optional<RigidBody> contact_;
@@ -636,6 +642,8 @@ std::unique_ptr<Stepper> make_stepper(Model model, const SolverOptions& options,
     if (stages.second_body >= n) throw std::invalid_argument("the second body holds no particle");
     if (options.scheme != Scheme::usl) throw std::invalid_argument("two bodies in contact step with usl only");
     if (stages.contact) throw std::invalid_argument("two bodies in contact cannot also touch a rigid master");
+    if (!stages.rest_points.empty())
+      throw std::invalid_argument("rest points serve one body (each body's grid field would need its own)");
   }
   for (const NodeConstraint& c : stages.constraints) {
     if (c.axis != 0 && c.axis != 1) throw std::invalid_argument("a node constraint's axis is 0 (x) or 1 (y)");

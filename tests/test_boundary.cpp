@@ -1,20 +1,27 @@
-// Boundary conditions (solver/boundary.hpp) and the classical exact-solution
+// Boundary conditions (solver/boundary.hpp, solver/rest_points.hpp) and the classical exact-solution
 // scenes built on them: prescribed node motion follows u(t) exactly and its
 // reaction balances the grid force; a traction puts its total force into the
 // body's momentum; damping takes energy out; the uniaxial bar, simple shear
 // and the neo-Hookean bar settle to their exact static states.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include <Eigen/QR>
 
 #ifdef MPMVV_HAVE_FFTW
 #include "analytic/fft.hpp"
 #endif
 #include "solver/boundary.hpp"
 #include "solver/explicit_stepper.hpp"
+#include "solver/rest_points.hpp"
+#include "solver/shape/bspline.hpp"
 #include "tools/app/scene.hpp"
 
 namespace {
@@ -89,6 +96,99 @@ TEST(Boundary, ConstraintSetsVelocityAndReturnsReaction) {
   EXPECT_EQ(g.velocity[1].x(), 7.0);
   ASSERT_EQ(reactions.size(), 1u);
   EXPECT_NEAR(reactions[0], 2.0 * (2.0 * (v - 1.0) / kick - 6.0), 1e-12);
+}
+
+// Rest points (rest_points.hpp): after the projection the grid field, read
+// with the quadratic B-splines, is zero at every point; the correction is the
+// nearest in kinetic energy (M dv lies in the span of the rows, C^T lambda);
+// the acceleration changes with the velocity; nodes a constraint prescribes
+// keep their value; and a field already at rest there is left as it is.
+TEST(Boundary, RestPointsHoldTheFieldAtRestNearestInKineticEnergy) {
+  const GridGeometry grid = GridGeometry::walled(Vec2(0.0, 0.0), 0.1, 12, 12);
+  std::vector<Vec2> points;
+  for (int k = 0; k < 9; ++k) {
+    const double a = 0.7 * k;
+    points.push_back(Vec2(0.6 + 0.3 * std::cos(a), 0.6 + 0.3 * std::sin(a)));
+  }
+  const auto rows = mpmvv::basis_rows<mpmvv::BsplineShape>(grid, points);
+  ASSERT_EQ(rows.size(), points.size());
+  GridFields g;
+  g.resize(grid.node_count());
+  std::uint64_t state = 12345;
+  auto next = [&state] {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return double(state >> 11) * 0x1.0p-53;
+  };
+  for (std::size_t i = 0; i < grid.node_count(); ++i) {
+    g.mass[i] = 0.5 + next();
+    g.velocity[i] = Vec2(next() - 0.5, next() - 0.5);
+    g.acceleration[i] = Vec2(next(), next());
+  }
+  // One node the first point weighs is prescribed.
+  std::vector<unsigned char> prescribed(2 * grid.node_count(), 0);
+  const int fixed = rows[0][0].first;
+  prescribed[2 * std::size_t(fixed) + 1] = 1;
+  const GridFields before = g;
+  mpmvv::RestPoints rest(rows, prescribed);
+  const double kick = 0.01;
+  rest.apply(g, kick);
+
+  auto field_at = [&](std::size_t b, int axis) {
+    double v = 0.0;
+    for (const auto& [node, w] : rows[b]) v += w * g.velocity[std::size_t(node)][axis];
+    return v;
+  };
+  for (std::size_t b = 0; b < points.size(); ++b)
+    for (int axis : {0, 1}) EXPECT_NEAR(field_at(b, axis), 0.0, 1e-13) << "point " << b << " axis " << axis;
+  EXPECT_EQ(g.velocity[std::size_t(fixed)], before.velocity[std::size_t(fixed)]);
+
+  // M dv = C^T lambda for some lambda: least squares leaves no residual.
+  std::vector<int> nodes;
+  for (const auto& row : rows)
+    for (const auto& [node, w] : row)
+      if (node != fixed) nodes.push_back(node);
+  std::sort(nodes.begin(), nodes.end());
+  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  Eigen::MatrixXd Ct = Eigen::MatrixXd::Zero(Eigen::Index(nodes.size()), Eigen::Index(rows.size()));
+  for (std::size_t b = 0; b < rows.size(); ++b)
+    for (const auto& [node, w] : rows[b]) {
+      const auto at = std::lower_bound(nodes.begin(), nodes.end(), node);
+      if (at != nodes.end() && *at == node) Ct(at - nodes.begin(), Eigen::Index(b)) = w;
+    }
+  for (int axis : {0, 1}) {
+    Eigen::VectorXd momentum(Eigen::Index(nodes.size()));
+    for (std::size_t k = 0; k < nodes.size(); ++k) {
+      const std::size_t i = std::size_t(nodes[k]);
+      const double dv = g.velocity[i][axis] - before.velocity[i][axis];
+      momentum[Eigen::Index(k)] = g.mass[i] * dv;
+      EXPECT_NEAR(g.acceleration[i][axis] - before.acceleration[i][axis], dv / kick, 1e-10);
+    }
+    const Eigen::VectorXd lambda = Ct.colPivHouseholderQr().solve(momentum);
+    EXPECT_GT(momentum.norm(), 1e-3);
+    EXPECT_LT((Ct * lambda - momentum).norm(), 1e-12 * momentum.norm());
+  }
+  // Nodes no point weighs keep their motion.
+  for (std::size_t i = 0; i < grid.node_count(); ++i) {
+    if (!std::binary_search(nodes.begin(), nodes.end(), int(i))) {
+      EXPECT_EQ(g.velocity[i], before.velocity[i]);
+    }
+  }
+
+  const GridFields held = g;
+  rest.apply(g, kick);
+  for (std::size_t i = 0; i < grid.node_count(); ++i)
+    EXPECT_NEAR((g.velocity[i] - held.velocity[i]).norm(), 0.0, 1e-14);
+}
+
+// A rest point where the grid basis would leave the grid is refused by name.
+TEST(Boundary, RestPointBeyondTheGridIsRefused) {
+  const GridGeometry grid = GridGeometry::walled(Vec2(0.0, 0.0), 0.1, 12, 12);
+  try {
+    (void)mpmvv::basis_rows<mpmvv::BsplineShape>(grid, {Vec2(0.5, 0.5), Vec2(1.4, 0.5)});
+    FAIL() << "a point outside the walls was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("rest point (1.4, 0.5)"), std::string::npos) << e.what();
+  }
 }
 
 // A block whose bottom row of nodes is driven along u_y(t) = 1e-3 sin(t):

@@ -69,6 +69,7 @@ struct BsplineShapeT {
   static constexpr bool reads_deformation_gradient = false;
   static constexpr bool gradients_beyond_grid_basis = false;  // the grid basis itself
   static constexpr bool has_domain = false;                   // a point, as in standard MPM
+  using GridBasis = BsplineShapeT;  // the basis a grid field is read with at a point
   // How far, in cells, a particle keeps from every wall (above).
   static constexpr double wall_clearance = 0.5 * (Degree - 1);
 

@@ -31,6 +31,7 @@
 #include <cstddef>
 
 #include "../particles.hpp"
+#include "linear.hpp"
 #include "stencil.hpp"
 
 namespace mpmvv {
@@ -105,6 +106,7 @@ struct CpdiExactShapeT {
   static constexpr bool reads_deformation_gradient = true;
   static constexpr bool gradients_beyond_grid_basis = false;  // exact averages of the grid basis
   static constexpr bool has_domain = true;
+  using GridBasis = LinearShapeT<G>;  // the domain averages the hats
 
   const GridGeometry* grid;
   const Vec2* position;

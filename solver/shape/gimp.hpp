@@ -14,6 +14,7 @@
 #include <cstddef>
 
 #include "../particles.hpp"
+#include "linear.hpp"
 #include "stencil.hpp"
 
 namespace mpmvv {
@@ -74,6 +75,7 @@ struct GimpShapeT {
   static constexpr bool reads_deformation_gradient = false;
   static constexpr bool gradients_beyond_grid_basis = false;  // averages of the grid basis
   static constexpr bool has_domain = true;
+  using GridBasis = LinearShapeT<G>;  // the domain averages the hats
 
   const GridGeometry* grid;
   const Vec2* position;

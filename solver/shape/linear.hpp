@@ -61,6 +61,7 @@ struct LinearShapeT {
   static constexpr bool reads_deformation_gradient = false;
   static constexpr bool gradients_beyond_grid_basis = false;  // the grid basis itself
   static constexpr bool has_domain = false;                   // a point (eq. 1.88)
+  using GridBasis = LinearShapeT;  // the basis a grid field is read with at a point
 
   const GridGeometry* grid;
   const Vec2* position;

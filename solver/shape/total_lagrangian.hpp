@@ -57,6 +57,7 @@ struct TotalLagrangianShapeT {
   static constexpr bool gradients_beyond_grid_basis = false;  // G0 is the reference basis's own
   static constexpr bool total_lagrangian = true;
   static constexpr bool has_domain = Reference::has_domain;
+  using GridBasis = typename Reference::GridBasis;  // on the reference grid
 
   Reference reference;             // the method's basis at X_p
   const Mat2* deformation_gradient;
