@@ -61,9 +61,10 @@ enum class ForceQuadrature {
 inline const char* to_string(ForceQuadrature q) { return q == ForceQuadrature::centroid ? "centroid" : "domain"; }
 
 // The body-force stage of a manufactured scene. The reference domain of
-// particle p is the rectangle X_p + [-l_x, l_x] x [-l_y, l_y], l = its
-// half_size (uGIMP and CPDI: the seeded square of the particle's area, halved
-// along with the particle when a CPDI domain splits); a particle without one
+// particle p is the parallelogram X_p + A_p [-1, 1]^2, A_p = diag(l_p) with l
+// its half_size (uGIMP and CPDI: the seeded square of the particle's area,
+// halved along with the particle when a CPDI domain splits) or A_p its
+// turned half-vectors (solver/domain_angle.hpp); a particle without one
 // (linear MPM) takes the square of its reference area, sqrt(V_p0) / 2 (in
 // r-z, where V_p0 is the area's first moment about the axis,
 // sqrt(V_p0 / R_p) / 2). In r-z the Gauss points are weighted by their radius,
@@ -89,16 +90,16 @@ class ManufacturedBodyForce final : public BodyForce {
     const double g = 1.0 / std::sqrt(3.0);
     for (std::size_t p = 0; p < n; ++p) {
       const Vec2& X = P.reference_position[p];
-      Vec2 l;
+      Mat2 a;
       if (P.half_size.size() == n) {
-        l = P.half_size[p];
+        a = P.reference_domain(p);
       } else {
         const double area = axisymmetric ? P.reference_volume[p] / X.x() : P.reference_volume[p];
-        l = 0.5 * std::sqrt(area) * Vec2(1.0, 1.0);
+        a = 0.5 * std::sqrt(area) * Mat2::Identity();
       }
       double total = 0.0;
       for (std::size_t k = 0; k < kPoints; ++k) {
-        const Vec2 Y = X + g * Vec2(k % 2 == 0 ? -l.x() : l.x(), k / 2 == 0 ? -l.y() : l.y());
+        const Vec2 Y = X + g * (a * Vec2(k % 2 == 0 ? -1.0 : 1.0, k / 2 == 0 ? -1.0 : 1.0));
         points[kPoints * p + k] = Y;
         weight_[kPoints * p + k] = axisymmetric ? Y.x() : 1.0;
         total += weight_[kPoints * p + k];

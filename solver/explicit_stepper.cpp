@@ -4,11 +4,13 @@
 #include <chrono>
 #include <cstdint>
 #include <cmath>
+#include <numbers>
 #include <optional>
 #include <stdexcept>
 
 #include <fmt/format.h>
 
+#include "domain_angle.hpp"
 #include "rest_points.hpp"
 #include "split.hpp"
 #include "shape/cpdi.hpp"
@@ -53,13 +55,15 @@ class ExplicitStepper final : public Stepper {
  public:
   ExplicitStepper(Model model, Scheme scheme, VelocityTransfer transfer, Material material,
                   std::optional<Material> second_material, SceneStages stages, double gradient_scale,
-                  Dilatation dilatation, double split_length, double viscosity_linear, double viscosity_quadratic)
+                  Dilatation dilatation, double split_length, double open_cos, double viscosity_linear,
+                  double viscosity_quadratic)
       : Stepper(std::move(model)),
         scheme_(scheme),
         apic_(transfer == VelocityTransfer::apic),
         gradient_scale_(gradient_scale),
         dilatation_(dilatation),
         split_length_(split_length),
+        open_cos_(open_cos),
         viscosity_linear_(viscosity_linear),
         viscosity_quadratic_(viscosity_quadratic),
         material_(material),
@@ -84,6 +88,7 @@ class ExplicitStepper final : public Stepper {
     if (scheme_ == Scheme::musl) next_position_.resize(model_.particles.size());
     // The affine part starts at zero: the first map is FLIP's.
     if (apic_) model_.particles.affine_velocity.assign(model_.particles.size(), Mat2::Zero());
+    if (open_cos_ < 1.0) start_domain_axes(model_.particles);
     if (dilatation_ != Dilatation::particle) volume_sums_.resize(std::size_t(max_threads()));
     if (damping_ > 0.0) fixed_components_ = prescribed_components(model_.grid.node_count(), constraints_);
     if (second_ > 0) {
@@ -100,12 +105,15 @@ class ExplicitStepper final : public Stepper {
       case Scheme::usf: step_usf(t, dt, kick); break;
       case Scheme::musl: step_musl(t, dt, kick); break;
     }
-    // Between steps, where no stage holds the particle arrays.
-    if constexpr (Shape::reads_deformation_gradient)
+    // Between steps, where no stage holds the particle arrays: domains are
+    // turned first, and a split then halves the turned domain.
+    if constexpr (Shape::reads_deformation_gradient) {
+      if (open_cos_ < 1.0) open_sheared_domains(model_.particles, open_cos_);
       if (split_length_ > 0.0 && split_long_domains(model_.particles, split_length_) > 0) {
         if (scheme_ == Scheme::musl) next_position_.resize(model_.particles.size());
         if (body_force_) body_force_->prepare(model_.particles);
       }
+    }
   }
 
   // With bulk viscosity the fastest grid mode is damped at the ratio xi of the
@@ -480,6 +488,7 @@ class ExplicitStepper final : public Stepper {
   double gradient_scale_;
   Dilatation dilatation_;
   double split_length_;  // CPDI domains longer than this are split in two (split.hpp); 0: never
+  double open_cos_;  // CPDI domains whose sides meet at |cos| above this are turned (domain_angle.hpp); 1: never
   double viscosity_linear_, viscosity_quadratic_;  // bulk viscosity C0, C1 (add_bulk_viscosity); 0: none
   double viscous_ratio_ = 0.0;                     // its damping ratio in the last step
   std::vector<double> volume_before_;              // with bulk viscosity: V_p before the deformation update
@@ -504,6 +513,12 @@ class ExplicitStepper final : public Stepper {
   std::vector<Vec2> tracer_reference_;         // total Lagrangian: where each tracer reads the grid
 };
 
+// The cosine above which open_sheared_domains acts, from the angle in degrees below
+// which a domain is turned; 1 (never) for 0.
+inline double min_domain_angle_cosine(double degrees) {
+  return degrees > 0.0 ? std::cos(degrees * std::numbers::pi / 180.0) : 1.0;
+}
+
 template <class Shape>
 std::unique_ptr<Stepper> make_for_shape(Model model, const SolverOptions& o, const MaterialModel& material,
                                         SceneStages stages) {
@@ -521,6 +536,7 @@ std::unique_ptr<Stepper> make_for_shape(Model model, const SolverOptions& o, con
                                                                  std::move(stages),
                                                                  o.cpdi_gradient_scale, o.dilatation,
                                                                  o.split_domains_beyond * model.grid.h,
+                                                                 min_domain_angle_cosine(o.min_domain_angle),
                                                                  o.bulk_viscosity_linear, o.bulk_viscosity_quadratic);
       },
       material);
@@ -546,7 +562,11 @@ std::unique_ptr<Stepper> make_for_geometry(Model model, const SolverOptions& o, 
   switch (o.method) {
     case Method::linear: return make_for_shape<LinearShapeT<G>>(std::move(model), o, material, std::move(stages));
     case Method::gimp: return make_for_shape<GimpShapeT<G>>(std::move(model), o, material, std::move(stages));
-    case Method::cpdi: return make_for_shape<CpdiShapeT<G>>(std::move(model), o, material, std::move(stages));
+    case Method::cpdi:
+      if constexpr (G == Geometry::plane_strain)
+        if (o.min_domain_angle > 0.0)
+          return make_for_shape<CpdiShapeT<G, true>>(std::move(model), o, material, std::move(stages));
+      return make_for_shape<CpdiShapeT<G>>(std::move(model), o, material, std::move(stages));
     case Method::cpdi_exact:
       return make_for_shape<CpdiExactShapeT<G>>(std::move(model), o, material, std::move(stages));
     case Method::bspline:
@@ -604,6 +624,19 @@ std::unique_ptr<Stepper> make_stepper(Model model, const SolverOptions& options,
     if (options.geometry != Geometry::plane_strain)
       throw std::invalid_argument("split_domains_beyond is plane strain only");
     if (stages.second_body > 0) throw std::invalid_argument("split_domains_beyond serves one body only");
+  }
+  // Below a right angle: the rectangle's orientation is the principal axes',
+  // which a square domain does not have (round-off would pick them).
+  if (!(options.min_domain_angle >= 0.0 && options.min_domain_angle < 90.0))
+    throw std::invalid_argument("min_domain_angle is an angle in degrees from 0 (never) to below 90");
+  if (options.min_domain_angle > 0.0) {
+    if (options.method != Method::cpdi) throw std::invalid_argument("min_domain_angle is for method cpdi only");
+    if (options.geometry != Geometry::plane_strain)
+      throw std::invalid_argument("min_domain_angle is plane strain only (in r-z the domain's moments carry "
+                                  "the weight r)");
+    if (options.formulation == Formulation::total)
+      throw std::invalid_argument("min_domain_angle serves the updated formulation: total Lagrangian domains "
+                                  "never deform");
   }
   if (options.formulation == Formulation::total) {
     // What the reference grid cannot do yet, or does not need.

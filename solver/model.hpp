@@ -56,6 +56,10 @@ struct SolverOptions {
   // CPDI only: a domain longer than this many cells along one of its vectors
   // is split in two along it after a step (split.hpp); 0: never.
   double split_domains_beyond = 0.0;
+  // CPDI only: a domain whose sides meet at less than this angle [degrees]
+  // is turned after a step, keeping its centroid, area and second moment of
+  // area, until they meet at this angle (domain_angle.hpp); 0: never.
+  double min_domain_angle = 0.0;
   // Artificial bulk viscosity (002_c3305cb8b1bc1490.txt eqs. 1.66-1.67,
   // add_bulk_viscosity in stages.hpp): the linear and quadratic coefficients
   // C0 and C1; both 0: none.

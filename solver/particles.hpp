@@ -29,6 +29,11 @@ struct Particles {
   // its parallelogram with r_i = F_p (l_i e_i), eq. 1.97. Empty for linear MPM.
   std::vector<Vec2> half_size;
 
+  // Optional, CPDI with turned domains only (domain_angle.hpp): the domain's
+  // half-vectors in the reference configuration as the columns of A_p, the
+  // current ones being F_p A_p. Empty otherwise, when A_p = diag(half_size).
+  std::vector<Mat2> domain_axes;
+
   // Optional, exact CPDI only: a particle domain of any polygonal shape, the
   // reference outline's points relative to X_p (domain_vertex[domain_first[p]]
   // up to domain_first[p + 1]); its current outline is x_p + F_p (X_k - X_p).
@@ -51,6 +56,15 @@ struct Particles {
   std::vector<Vec2> body_force;
 
   std::size_t size() const { return position.size(); }
+
+  // A_p: the columns span particle p's reference domain about X_p.
+  Mat2 reference_domain(std::size_t p) const {
+    if (!domain_axes.empty()) return domain_axes[p];
+    Mat2 a = Mat2::Zero();
+    a(0, 0) = half_size[p].x();
+    a(1, 1) = half_size[p].y();
+    return a;
+  }
 
   void resize(std::size_t n) {
     position.resize(n, Vec2::Zero());

@@ -86,6 +86,10 @@ class RestPoints {
   // with it (a = (v - v_before) / kick).
   void apply(GridFields& g, double kick) {
     const std::size_t n = involved_.size();
+    // A state already lost (a mass or velocity not finite) is left to the
+    // health scan, which names the particle; the system is not formed on it.
+    for (int node : involved_)
+      if (!std::isfinite(g.mass[std::size_t(node)]) || !g.velocity[std::size_t(node)].allFinite()) return;
     bool same = mass_.size() == n;
     for (std::size_t k = 0; k < n && same; ++k) same = mass_[k] == g.mass[std::size_t(involved_[k])];
     if (!same) factor(g);

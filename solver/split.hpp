@@ -1,13 +1,16 @@
 // Splitting of stretched CPDI domains. Under large shear a domain vector
-// r_i = F_p (l_i e_i) (002_c3305cb8b1bc1490.txt eq. 1.97) grows to span many
-// cells, and the bilinear interpolation of the grid basis from the domain's
-// four corners (eq. 1.95) stops describing the particle: it skips the kinks
-// of every cell line in between. A particle whose domain is longer than a
-// set length along r_i is replaced by its two halves along it:
-//   x = x_p -+ r_i / 2,   X = X_p -+ (l_i / 2) e_i,   l_i <- l_i / 2,
+// r_i = F_p (l_i e_i) (002_c3305cb8b1bc1490.txt eq. 1.97), or F_p a_i for a
+// turned domain whose reference half-vectors are the columns a_i of A_p
+// (domain_angle.hpp), grows to span many cells, and the bilinear interpolation of
+// the grid basis from the domain's four corners (eq. 1.95) stops describing
+// the particle: it skips the kinks of every cell line in between. A particle
+// whose domain is longer than a set length along r_i is replaced by its two
+// halves along it:
+//   x = x_p -+ r_i / 2,   X = X_p -+ a_i / 2,   a_i <- a_i / 2,
 //   m, V, V_0 halved;  v, F, stress unchanged
-// (under APIC each half takes the parent's affine velocity field at its own
-// centre, v = v_p -+ C_p r_i / 2, and keeps C_p).
+// (a_i = l_i e_i for a domain never turned, where l_i is halved; under APIC each
+// half takes the parent's affine velocity field at its own centre,
+// v = v_p -+ C_p r_i / 2, and keeps C_p).
 // The map of the domain, x = x_p + F_p (X - X_p), is affine, so the halves
 // tile their parent exactly in both configurations and together carry its
 // mass, momentum, kinetic and strain energy, and first moment of mass.
@@ -25,23 +28,28 @@ namespace mpmvv {
 // again). Returns the number of splits.
 inline std::size_t split_long_domains(Particles& P, double max_length) {
   std::size_t splits = 0;
+  const bool turned = !P.domain_axes.empty();
   for (std::size_t p = 0; p < P.size(); ++p) {
     for (;;) {
-      const Vec2 l = P.half_size[p];
-      const Vec2 r1 = P.deformation_gradient[p].col(0) * l.x(), r2 = P.deformation_gradient[p].col(1) * l.y();
-      const double long1 = 2.0 * r1.norm(), long2 = 2.0 * r2.norm();
+      const Mat2 a = P.reference_domain(p);
+      const Mat2 s = P.deformation_gradient[p] * a;
+      const double long1 = 2.0 * s.col(0).norm(), long2 = 2.0 * s.col(1).norm();
       if (!(long1 > max_length || long2 > max_length)) break;  // NaN stays: the health scan reports it
       const int axis = long1 >= long2 ? 0 : 1;
-      const Vec2 r = axis == 0 ? r1 : r2;
-      Vec2 reference_step = Vec2::Zero();
-      reference_step[axis] = 0.5 * l[axis];
+      const Vec2 r = s.col(axis);
+      const Vec2 reference_step = 0.5 * a.col(axis);
       const std::size_t q = P.size();
       P.resize(q + 1);
-      P.half_size.push_back(l);
+      P.half_size.push_back(P.half_size[p]);
       if (!P.body_force.empty()) P.body_force.push_back(P.body_force[p]);
       if (!P.affine_velocity.empty()) P.affine_velocity.push_back(P.affine_velocity[p]);
       // The halves: p keeps the minus side, q takes the plus side.
-      P.half_size[p][axis] = P.half_size[q][axis] = 0.5 * l[axis];
+      if (turned) {
+        P.domain_axes[p].col(axis) *= 0.5;
+        P.domain_axes.push_back(P.domain_axes[p]);
+      } else {
+        P.half_size[p][axis] = P.half_size[q][axis] = 0.5 * P.half_size[p][axis];
+      }
       P.position[q] = P.position[p] + 0.5 * r;
       P.position[p] -= 0.5 * r;
       P.reference_position[q] = P.reference_position[p] + reference_step;
@@ -54,9 +62,9 @@ inline std::size_t split_long_domains(Particles& P, double max_length) {
       }
       P.deformation_gradient[q] = P.deformation_gradient[p];
       P.stress[q] = P.stress[p];
-      for (std::vector<double>* a : {&P.mass, &P.volume, &P.reference_volume}) {
-        (*a)[p] *= 0.5;
-        (*a)[q] = (*a)[p];
+      for (std::vector<double>* v : {&P.mass, &P.volume, &P.reference_volume}) {
+        (*v)[p] *= 0.5;
+        (*v)[q] = (*v)[p];
       }
       ++splits;
     }

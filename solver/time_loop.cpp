@@ -131,7 +131,17 @@ RunOutcome run_time_loop(Stepper& stepper, const TimeLoopOptions& options, RunOb
                         : out.steps == 0                                              ? 0.5 * dt
                                                                                       : 0.5 * (previous_dt + dt);
     out.particle_steps += static_cast<long long>(n());
-    stepper.step(t, dt, kick);
+    try {
+      stepper.step(t, dt, kick);
+    } catch (const std::runtime_error& e) {
+      // A stage that cannot go on (a constraint system that does not factor):
+      // the run ends here with what it has, as for an unhealthy particle.
+      out.failure_reason = "stage failed";
+      out.failure_detail = e.what();
+      out.failure_time = t;
+      out.failure_step = out.steps;
+      break;
+    }
     previous_dt = dt;
     ++out.steps;
     if (const std::string why = stepper.step_failure(); !why.empty()) {

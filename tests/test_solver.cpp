@@ -12,12 +12,14 @@
 #include <limits>
 #include <memory>
 #include <numbers>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "solver/explicit_stepper.hpp"
 #include "solver/parallel.hpp"
+#include "solver/domain_angle.hpp"
 #include "solver/shape/cpdi.hpp"
 #include "solver/split.hpp"
 #include "solver/time_loop.hpp"
@@ -565,6 +567,142 @@ TEST(CpdiSplit, MakeStepperRefusesSplittingElsewhere) {
                std::invalid_argument);
 }
 
+// ---------------------------------------------------------------- domain angle
+
+namespace {
+
+// The cosine of the angle between the columns of s.
+double side_cosine(const Mat2& s) { return s.col(0).dot(s.col(1)) / (s.col(0).norm() * s.col(1).norm()); }
+
+// Second moment of area of the domain x_p + s xi, xi in [-1, 1]^2, about o.
+Mat2 second_moment(const Mat2& s, const Vec2& centre, const Vec2& o) {
+  const double area = 4.0 * std::abs(mpmvv::determinant(s));
+  return area / 3.0 * s * s.transpose() + area * (centre - o) * (centre - o).transpose();
+}
+
+// Four domains: sheared to 18 degrees (gamma = 3), stretched and skewed to
+// 73 degrees, barely sheared (79 degrees) and unsheared.
+Particles domains_to_turn() {
+  Particles P;
+  P.resize(4);
+  P.half_size.assign(4, Vec2(0.05, 0.04));
+  Mat2 shear, skew, mild;
+  shear << 1.0, 3.0, 0.0, 1.0;
+  skew << 2.5, 0.3, -0.4, 0.6;
+  mild << 1.0, 0.2, 0.0, 1.0;
+  P.deformation_gradient = {shear, skew, mild, Mat2::Identity()};
+  for (std::size_t p = 0; p < 4; ++p) {
+    P.position[p] = Vec2(0.3 * double(p), -0.2);
+    P.reference_position[p] = Vec2(0.25 * double(p), -0.1);
+    P.reference_volume[p] = 4.0 * 0.05 * 0.04;
+    P.volume[p] = mpmvv::determinant(P.deformation_gradient[p]) * P.reference_volume[p];
+    P.mass[p] = 1000.0 * P.reference_volume[p];
+  }
+  return P;
+}
+
+}  // namespace
+
+// A domain whose sides meet below the set angle is turned within the
+// parallelograms of its centroid, area and second moment of area (in both
+// configurations) until they meet at that angle, by the smallest turn; the
+// others are left as they are; a second pass finds nothing left to turn.
+TEST(CpdiDomainAngle, TurnKeepsTheMomentsAndOpensTheSidesToTheSetAngle) {
+  Particles P = domains_to_turn();
+  mpmvv::start_domain_axes(P);
+  const Particles before = P;
+  const double max_cos = std::cos(30.0 * std::numbers::pi / 180.0);
+  EXPECT_EQ(mpmvv::open_sheared_domains(P, max_cos), 1u);  // only the 18-degree one is below 30 degrees
+  const double wide = std::cos(75.0 * std::numbers::pi / 180.0);
+  Particles P75 = before;
+  EXPECT_EQ(mpmvv::open_sheared_domains(P75, wide), 2u);  // and the 73-degree one below 75
+  for (const auto& [after, limit] : {std::pair<const Particles*, double>{&P, max_cos}, {&P75, wide}}) {
+    for (std::size_t p = 0; p < 4; ++p) {
+      SCOPED_TRACE("particle " + std::to_string(p) + ", limit " + std::to_string(limit));
+      const Mat2 A0 = before.domain_axes[p], A = after->domain_axes[p];
+      const Mat2 s0 = before.deformation_gradient[p] * A0, s = after->deformation_gradient[p] * A;
+      const Vec2 x = after->position[p];
+      EXPECT_LT((second_moment(s, x, x) - second_moment(s0, x, x)).norm(), 1e-14 * second_moment(s0, x, x).norm());
+      EXPECT_LT((A * A.transpose() - A0 * A0.transpose()).norm(), 1e-14 * (A0 * A0.transpose()).norm());
+      EXPECT_NEAR(mpmvv::determinant(A), mpmvv::determinant(A0), 1e-15);
+      if (std::abs(side_cosine(s0)) > limit) {
+        EXPECT_NEAR(std::abs(side_cosine(s)), limit, 1e-12);
+        // The smallest turn: nine tenths of it leave the sides closer than the limit.
+        const Mat2 W = mpmvv::inverse(A0) * A;
+        const double t = 0.9 * std::atan2(W(1, 0), W(0, 0));
+        Mat2 part;
+        part << std::cos(t), -std::sin(t), std::sin(t), std::cos(t);
+        EXPECT_GT(std::abs(side_cosine(s0 * part)), limit);
+      } else {
+        EXPECT_EQ(A, A0);
+      }
+    }
+  }
+  const Particles turned = P;
+  mpmvv::open_sheared_domains(P, max_cos);
+  for (std::size_t p = 0; p < 4; ++p)
+    EXPECT_LT((P.domain_axes[p] - turned.domain_axes[p]).norm(), 1e-14) << "particle " << p;
+}
+
+// A turned domain splits along its own half-vectors: the halves' centres lie
+// on the parent's affine map, x - x_p = F (X - X_p), and together they carry
+// the parent's mass and second moment of area about its centroid.
+TEST(CpdiDomainAngle, TurnedDomainSplitsIntoHalvesThatTileIt) {
+  Particles P = domains_to_turn();
+  mpmvv::start_domain_axes(P);
+  mpmvv::open_sheared_domains(P, std::cos(60.0 * std::numbers::pi / 180.0));
+  const Particles parent = P;
+  const double limit = 0.15;
+  const std::size_t splits = mpmvv::split_long_domains(P, limit);
+  EXPECT_GE(splits, 2u);
+  ASSERT_EQ(P.domain_axes.size(), P.size());
+  for (std::size_t q = 0; q < parent.size(); ++q) {
+    SCOPED_TRACE("parent " + std::to_string(q));
+    const Vec2 xq = parent.position[q];
+    const Mat2 sq = parent.deformation_gradient[q] * parent.domain_axes[q];
+    Mat2 moment = Mat2::Zero();
+    double mass = 0.0;
+    for (std::size_t p = 0; p < P.size(); ++p) {
+      if (P.deformation_gradient[p] != parent.deformation_gradient[q]) continue;
+      const Mat2 s = P.deformation_gradient[p] * P.domain_axes[p];
+      EXPECT_LE(2.0 * s.col(0).norm(), limit * (1.0 + 1e-14));
+      EXPECT_LE(2.0 * s.col(1).norm(), limit * (1.0 + 1e-14));
+      EXPECT_LT((P.position[p] - xq - parent.deformation_gradient[q] *
+                                         (P.reference_position[p] - parent.reference_position[q]))
+                    .norm(),
+                1e-14);
+      moment += second_moment(s, P.position[p], xq);
+      mass += P.mass[p];
+    }
+    EXPECT_NEAR(mass, parent.mass[q], 1e-14 * parent.mass[q]);
+    EXPECT_LT((moment - second_moment(sq, xq, xq)).norm(), 1e-12 * second_moment(sq, xq, xq).norm());
+  }
+}
+
+// The angle is for CPDI in plane strain under the updated formulation, from
+// 0 (never) to below a right angle.
+TEST(CpdiDomainAngle, MakeStepperRefusesTheAngleElsewhere) {
+  SolverOptions gimp{Method::gimp, Scheme::usl};
+  gimp.min_domain_angle = 30.0;
+  EXPECT_THROW(mpmvv::make_stepper(disk_model(Method::gimp), gimp, MaterialModel{kSolid}, nullptr),
+               std::invalid_argument);
+  for (double angle : {-1.0, 90.0}) {
+    SolverOptions cpdi{Method::cpdi, Scheme::usl};
+    cpdi.min_domain_angle = angle;
+    EXPECT_THROW(mpmvv::make_stepper(disk_model(Method::cpdi), cpdi, MaterialModel{kSolid}, nullptr),
+                 std::invalid_argument)
+        << angle;
+  }
+  SolverOptions total{Method::cpdi, Scheme::usl};
+  total.formulation = mpmvv::Formulation::total;
+  total.min_domain_angle = 30.0;
+  EXPECT_THROW(mpmvv::make_stepper(disk_model(Method::cpdi), total, MaterialModel{kSolid}, nullptr),
+               std::invalid_argument);
+  SolverOptions fine{Method::cpdi, Scheme::usl};
+  fine.min_domain_angle = 30.0;
+  EXPECT_NO_THROW(mpmvv::make_stepper(disk_model(Method::cpdi), fine, MaterialModel{kSolid}, nullptr));
+}
+
 // Exact CPDI's stencil holds 3 x 3 cells: a particle stretched beyond them
 // stops the run with its own reason, not as "outside grid".
 TEST(TimeLoop, ExactCpdiDomainBeyondItsStencilIsReportedAsTooWide) {
@@ -743,6 +881,42 @@ TEST(TimeLoop, LandsOnOutputTimesWithinTheCflStep) {
   // CFL step apart, and the loop splits a last stretch shorter than two steps
   // in two, so no step is shorter than a quarter of the CFL step.
   for (const RecordingStepper::Call& c : stepper.calls) EXPECT_GT(c.dt, 0.25 * c.cfl_bound);
+}
+
+// A stepper whose stage gives up at its third step, as a system of rest
+// points that does not factor does.
+class GivingUpStepper final : public Stepper {
+ public:
+  explicit GivingUpStepper(std::unique_ptr<Stepper> inner) : Stepper(inner->model()), inner_(std::move(inner)) {}
+  void step(double t, double dt, double kick) override {
+    if (++steps_ == 3) throw std::runtime_error("rest points: the constraint system could not be factored");
+    inner_->step(t, dt, kick);
+  }
+  mpmvv::ParticleScan scan() const override { return inner_->scan(); }
+  mpmvv::ParticleFault diagnose(std::size_t p) const override { return inner_->diagnose(p); }
+  mpmvv::Monitors monitors() const override { return inner_->monitors(); }
+
+ private:
+  std::unique_ptr<Stepper> inner_;
+  int steps_ = 0;
+};
+
+// A stage that cannot go on ends the run as failed with the stage's message,
+// at the time the last whole step reached, and the loop returns what it has
+// (an exception escaping the run would lose the results file).
+TEST(TimeLoop, AStageThatGivesUpEndsTheRunAsFailed) {
+  auto inner = mpmvv::make_stepper(disk_model(Method::linear), SolverOptions{Method::linear, Scheme::usl},
+                                   MaterialModel{kSolid}, nullptr);
+  GivingUpStepper stepper(std::move(inner));
+  NullObserver observer;
+  const mpmvv::RunOutcome o = mpmvv::run_time_loop(stepper, short_run(0.5), observer);
+  EXPECT_FALSE(o.completed);
+  EXPECT_EQ(o.failure_reason, "stage failed");
+  EXPECT_NE(o.failure_detail.find("could not be factored"), std::string::npos) << o.failure_detail;
+  EXPECT_EQ(o.steps, 2);
+  EXPECT_EQ(o.failure_step, 2);
+  EXPECT_GT(o.time_reached, 0.0);
+  EXPECT_EQ(o.failure_time, o.time_reached);
 }
 
 // Output times that do not end at the end time are refused before any step.

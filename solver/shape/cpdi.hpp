@@ -1,6 +1,7 @@
 // CPDI with parallelogram particle domains (002_c3305cb8b1bc1490.txt section
 // 1.6.4, eqs. 1.94-1.100, in 2D). The domain of particle p is spanned by
-// r_1 = F_p (l_x e_x) and r_2 = F_p (l_y e_y) about its centroid (eq. 1.97);
+// r_1 = F_p (l_x e_x) and r_2 = F_p (l_y e_y) about its centroid (eq. 1.97),
+// or by the columns of F_p A_p once its domain has been turned (domain_angle.hpp);
 // the grid basis is interpolated bilinearly from its four corners (eq. 1.95),
 // which gives
 //   S_gp = (1/4) sum_c S_g(x_c),
@@ -24,7 +25,10 @@
 
 namespace mpmvv {
 
-template <Geometry G>
+// Turned: the domains are F_p A_p (Particles::domain_axes, domain_angle.hpp)
+// instead of F_p diag(l_p); a run that turns none steps the plain form, so
+// that the choice is made once per run, not once per particle.
+template <Geometry G, bool Turned = false>
 struct CpdiShapeT {
   static constexpr int stencil_size = 16;  // four nodes for each of four corners, at most
   static constexpr const char* name = "cpdi";
@@ -42,6 +46,7 @@ struct CpdiShapeT {
   const Vec2* position;
   const Mat2* deformation_gradient;
   const Vec2* half_size;
+  const Mat2* domain_axes;  // Turned: A_p; else null, and the domains span diag(half_size)
   double gradient_scale;  // 1, but for a deliberate fault (SolverOptions::cpdi_gradient_scale)
 
   // The domains span F_p diag(l_p); `deformation_gradient` may point to a copy
@@ -53,15 +58,20 @@ struct CpdiShapeT {
                          const Mat2* deformation_gradient = nullptr, double gradient_scale = 1.0) {
     return {&grid, particles.position.data(),
             deformation_gradient ? deformation_gradient : particles.deformation_gradient.data(),
-            particles.half_size.data(), gradient_scale};
+            particles.half_size.data(),
+            Turned ? particles.domain_axes.data() : nullptr, gradient_scale};
   }
 
   // s_p = [r_1 r_2], the current domain half-vectors as columns (eq. 1.97).
   Mat2 domain(std::size_t p) const {
     Mat2 s = deformation_gradient ? deformation_gradient[p] : Mat2::Identity();
-    s.col(0) *= half_size[p].x();
-    s.col(1) *= half_size[p].y();
-    return s;
+    if constexpr (Turned) {
+      return s * domain_axes[p];
+    } else {
+      s.col(0) *= half_size[p].x();
+      s.col(1) *= half_size[p].y();
+      return s;
+    }
   }
 
   Vec2 corner(std::size_t p, const Mat2& s, int c) const {

@@ -241,9 +241,10 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
                config.scene(), config.text("method"), o.time_reached, o.steps, o.wall_seconds, o.forcing_seconds,
                scene->particle_count(), scene->cell_size(), rate);
   else
-    fmt::print(out, "{} {}: FAILED at t = {:.4g} s, step {}, particle {}: {} ({})\n", config.scene(),
-               config.text("method"), o.failure_time, o.failure_step, o.failure_particle, o.failure_reason,
-               o.failure_detail);
+    fmt::print(out, "{} {}: FAILED at t = {:.4g} s, step {}{}: {} ({})\n", config.scene(), config.text("method"),
+               o.failure_time, o.failure_step,
+               o.failure_particle >= 0 ? fmt::format(", particle {}", o.failure_particle) : std::string(),
+               o.failure_reason, o.failure_detail);
   print_error_table(out, scene->errors());
   print_measurements(out, scene->measurements());
   fmt::print(out, "results: {}\n", output);

@@ -67,6 +67,11 @@ std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_
        "replaced by its two halves along it (0: never); keeps the corner interpolation of CPDI within a few cells "
        "under large shear",
        0.0, 1000.0, false, false},
+      {"min_domain_angle", KeyKind::real, 0.0,
+       "cpdi only, updated formulation: after a step, a domain whose sides meet at less than this angle [degrees] "
+       "is turned, keeping its centre, area and second moment of area, until they meet at this angle (0: never; "
+       "solver/domain_angle.hpp); bounds the CPDI gradient, which grows as 1 / sin of that angle, under large shear",
+       0.0, 89.0, false, false},
       {"bulk_viscosity", KeyKind::real, 0.0,
        "linear artificial bulk viscosity C0 (eq. 1.66 of the Vaango manual; 0.2 is typical, 0: none): a stress "
        "rho l C0 c tr(d) I, l the particle's thinnest width (at most h), that damps the particles' dilatation rate in "
@@ -127,6 +132,7 @@ SolverOptions solver_options(const Config& c) {
   o.formulation = c.text("formulation") == "total" ? Formulation::total : Formulation::updated;
   o.velocity_transfer = c.text("velocity_transfer") == "apic" ? VelocityTransfer::apic : VelocityTransfer::flip;
   o.split_domains_beyond = c.real("split_domains_beyond");
+  o.min_domain_angle = c.real("min_domain_angle");
   o.bulk_viscosity_linear = c.real("bulk_viscosity");
   o.bulk_viscosity_quadratic = c.real("bulk_viscosity_quadratic");
   return o;
