@@ -340,6 +340,14 @@ class HealthCurve:
     # cfl_step / stable_step: the step the CFL rule takes over the measured stable step 2 / omega_max
     # (stable_step_iterations > 0); None, or NaN at every time, where not measured
     step_ratio: np.ndarray = None
+    # max_wave_speed_ratio and max_basis_stiffening (results-format.md): what lifts the CFL step's
+    # signal speed above the small-strain wave speed; None, or NaN at every time, in older files
+    wave_ratio: np.ndarray = None
+    basis_stiffening: np.ndarray = None
+
+
+def _has_finite(values):
+    return values is not None and np.isfinite(np.asarray(values, float)).any()
 
 
 LINE_STYLES = ["-", "--", "-.", ":"]
@@ -350,16 +358,21 @@ def run_health(curves, title):
     its style; the line style changes after every len(COLOURS) curves so that no two
     look alike): the energy balance error (log), min J and max J with J = 0 dotted,
     the largest speed over wave speed, the largest domain distortion (log; a note
-    instead when every value is NaN, as for linear MPM); and a fifth when any curve
-    has a finite step_ratio: the step over the measured stable step, dotted at 1,
-    above which the linearized step is unstable. A curve with a finite
-    `stopped_at` gets an x there, at the height of its last drawn value."""
-    with_ratio = any(c.step_ratio is not None and np.isfinite(np.asarray(c.step_ratio, float)).any() for c in curves)
-    rows = 5 if with_ratio else 4
+    instead when every value is NaN, as for linear MPM); one more when any curve
+    has a finite wave_ratio or basis_stiffening: what lifts the CFL step's signal
+    speed above the small-strain wave speed, the material's state (solid) and the
+    basis (dotted), log; and one more when any curve has a finite step_ratio: the
+    step over the measured stable step, dotted at 1, above which the linearized
+    step is unstable. A curve with a finite `stopped_at` gets an x there, at the
+    height of its last drawn value."""
+    with_ratio = any(_has_finite(c.step_ratio) for c in curves)
+    with_lift = any(_has_finite(c.wave_ratio) or _has_finite(c.basis_stiffening) for c in curves)
+    rows = 4 + with_lift + with_ratio
     figure, axes = plt.subplots(rows, 1, figsize=(10.5, 2.75 * rows), sharex=True, squeeze=False,
                                 constrained_layout=True)
     energy, jacobian, speed, distortion = axes[:4, 0]
-    ratio = axes[4, 0] if with_ratio else None
+    lift = axes[4, 0] if with_lift else None
+    ratio = axes[rows - 1, 0] if with_ratio else None
     drawn = {energy: False, distortion: False}
     for k, curve in enumerate(curves):
         line = dict(color=curve.style.colour, marker=curve.style.marker, markersize=4, linewidth=1.2,
@@ -378,6 +391,11 @@ def run_health(curves, title):
         # every curve has a line here (NaN values draw nothing): the legend is taken from it
         speed.plot(t, curve.speed_ratio, label=curve.label, **line)
         _mark_stop(speed, curve, t, curve.speed_ratio)
+        if lift is not None:
+            for values, style in ((curve.wave_ratio, line["linestyle"]), (curve.basis_stiffening, ":")):
+                if _has_finite(values):
+                    lift.plot(t, values, **{**line, "linestyle": style})
+                    _mark_stop(lift, curve, t, values)
         if ratio is not None and curve.step_ratio is not None:
             ratio.plot(t, curve.step_ratio, **line)
             _mark_stop(ratio, curve, t, curve.step_ratio)
@@ -395,8 +413,15 @@ def run_health(curves, title):
     _label_panel(energy, "", "|energy created| / scale", "energy balance error")
     _label_panel(jacobian, "", "J = det F", "min J and max J over the particles")
     _label_panel(speed, "", "max |v| / c", "largest particle speed over its wave speed")
-    _label_panel(distortion, "" if ratio is not None else "time t [s]", "max domain distortion",
-                 "largest domain distortion (1: square)")
+    _label_panel(distortion, "" if lift is not None or ratio is not None else "time t [s]",
+                 "max domain distortion", "largest domain distortion (1: square)")
+    if lift is not None:
+        lift.axhline(1.0, color="black", linestyle="-", linewidth=0.6, alpha=0.5)
+        lift.set_yscale("log")
+        _plain_log_labels(lift)
+        _label_panel(lift, "" if ratio is not None else "time t [s]", "max c / c0, max k",
+                     "what slows the step: the particle's state and density, max c_p / c0 (solid), and the basis, "
+                     "max k_p (dotted)")
     if ratio is not None:
         ratio.axhline(1.0, color="black", linestyle=":", linewidth=1.0)
         ratio.set_ylim(bottom=0.0)

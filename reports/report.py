@@ -630,7 +630,9 @@ def health_figure(study, all_series, directory):
                                           monitors.column("min_J"), monitors.column("max_J"),
                                           monitors.column("max_speed_over_wave_speed"),
                                           monitors.column("max_domain_distortion"), style, stop,
-                                          monitors.column("cfl_step") / monitors.column("stable_step")))
+                                          monitors.column("cfl_step") / monitors.column("stable_step"),
+                                          monitors.column("max_wave_speed_ratio"),
+                                          monitors.column("max_basis_stiffening")))
     figure = figures.run_health(curves, f"{study}: run health at the output times")
     path = directory / f"{slug(study, 'health')}.png"
     figures.save_png(figure, path)
@@ -639,7 +641,11 @@ def health_figure(study, all_series, directory):
                "abs(work) any one work_* term has done so far, the scale of the blow-up test (log scale); "
                "min J and max J over the particles (the lower and upper line of a case's colour), dotted at J = 0; "
                "the largest particle speed over its wave speed; the largest CPDI domain distortion (1: a square "
-               "domain; log scale; none for linear MPM); where the runs measured it (stable_step_iterations), the "
+               "domain; log scale; none for linear MPM); where the results files have them, what lifts the signal "
+               "speed max(max(c_p, k_p c0_p) + |v_p|) that sets the CFL step (cfl h over it) above the small-strain "
+               "wave speed c0 at the reference density: the particle's state and density, max c_p / c0 (solid), and the basis, max k_p (dotted; CPDI's corner "
+               "interpolation, the total formulation's compressed cell), log scale; where the runs measured it "
+               "(stable_step_iterations), the "
                "step the CFL rule takes over the measured stable step 2 / omega_max of the linearized grid motion, "
                "unstable above 1 (dotted). x: the failure time of a failed case, at the height of its "
                "last recorded value (dotted from its last output).")

@@ -201,3 +201,27 @@ def test_measured_stable_step_adds_the_step_ratio(tmp_path, drawn):
     assert len(figure.axes) == 5
     four = figures.run_health(drawn["rz-cylinder: run health at the output times"], "four panels")
     assert len(four.axes) == 4
+
+
+@needs_gold
+def test_what_slows_the_step_gets_its_panel(tmp_path, drawn):
+    """Requirement: where the results files carry max_wave_speed_ratio and
+    max_basis_stiffening (what lifts the CFL step's signal speed above the
+    small-strain wave speed), each curve carries both, the figure gets a panel
+    for them and the caption names them; files without them draw no such panel."""
+    directory = gold_with_results(tmp_path / "suite", monitors_in=("ring", "rz-cylinder"))
+    for path in (directory / "cases").glob("ring-method=*.h5"):
+        with h5py.File(path, "a") as f:
+            group = f["probes/monitors"]
+            t = group["time"][:]
+            group["max_wave_speed_ratio"] = 1.0 + 2.0 * t
+            group["max_basis_stiffening"] = 1.0 + 0.5 * t
+    written, _ = report.write_report(directory, tmp_path / "out")
+    ring = drawn["ring: run health at the output times"]
+    assert ring and all(np.allclose(c.wave_ratio, 1.0 + 2.0 * c.time) for c in ring)
+    assert all(np.allclose(c.basis_stiffening, 1.0 + 0.5 * c.time) for c in ring)
+    cylinder = drawn["rz-cylinder: run health at the output times"]
+    assert all(np.isnan(c.wave_ratio).all() and np.isnan(c.basis_stiffening).all() for c in cylinder)
+    assert "the particle's state and density, max c_p / c0 (solid), and the basis, max k_p" in written["markdown"].read_text()
+    assert len(figures.run_health(ring, "with what slows the step").axes) == 5
+    assert len(figures.run_health(cylinder, "without").axes) == 4

@@ -1,6 +1,7 @@
 // What a run's health is read from, at every output time: energies, the range
 // of J, how fast particles move against the waves, how distorted the CPDI
-// domains are, and how many particles sit at the grid's edge. One pass over
+// domains are, how many particles sit at the grid's edge, and what lifts the
+// wave speeds that set the step. One pass over
 // the particles; a stepper calls it with its own shape and material.
 #pragma once
 
@@ -43,6 +44,19 @@ struct Monitors {
   // (NaN without domains: linear MPM).
   double max_distortion = std::numeric_limits<double>::quiet_NaN();
   std::size_t near_edge = 0;   // particles whose domain reaches past the middle of the grid's outermost cell layer
+  // What lifts the CFL step's signal speed above the body's small-strain wave
+  // speed c0 = sqrt(p_wave_modulus / rho_0) (stages.hpp: scan_particles, whose
+  // step is cfl h / max_p (max(c_p, k_p c0_p) + |v_p|), c0_p at the current
+  // density rho_0 / J_p): the particle's state, max c_p / c0 (a stretched
+  // neo-Hookean solid carries its waves faster along the stretch, and a
+  // particle whose J has grown is lighter for the same stiffness), and the
+  // basis, max k_p (CPDI's corner interpolation, stages.hpp: stiffening; for
+  // the total formulation the reference cell compressed to F_p h,
+  // 1 / min(1, stretch)). Both are 1 for an unstrained body on the grid's own
+  // basis, so a step that falls while both stay near 1 falls for a cause
+  // these do not name.
+  double max_wave_speed_ratio = 0.0;
+  double max_basis_stiffening = 0.0;
 };
 
 // Over particles [begin, end) of one material (by default all).
@@ -52,11 +66,11 @@ Monitors monitor_particles(const Shape& shape, const Material& material, const P
   Monitors m;
   const std::size_t n = std::min(end, P.size());
   double kinetic = 0.0, strain = 0.0, min_J = m.min_J, max_J = 0.0, mach = 0.0, spin = 0.0;
-  double distortion = 0.0;
+  double distortion = 0.0, wave_ratio = 0.0, basis_stiffening = 0.0;
   std::size_t near = 0;
   constexpr bool has_domain = Shape::has_domain;
 #pragma omp parallel for schedule(static) reduction(+ : kinetic, strain, near, spin) reduction(min : min_J) \
-    reduction(max : max_J, mach, distortion)
+    reduction(max : max_J, mach, distortion, wave_ratio, basis_stiffening)
   for (std::size_t p = begin; p < n; ++p) {
     const double F33 = out_of_plane_stretch<Shape::geometry>(P, p);
     const double J = determinant(P.deformation_gradient[p]) * F33;
@@ -65,9 +79,14 @@ Monitors monitor_particles(const Shape& shape, const Material& material, const P
     strain += P.reference_volume[p] * material.energy_density(P.deformation_gradient[p], F33);
     min_J = std::min(min_J, J);
     max_J = std::max(max_J, J);
-    const double c = std::sqrt(material.wave_modulus(P.deformation_gradient[p], F33, P.stress[p]) /
-                               (P.mass[p] / P.volume[p]));
+    const double density = P.mass[p] / P.volume[p];
+    const double c = std::sqrt(material.wave_modulus(P.deformation_gradient[p], F33, P.stress[p]) / density);
     mach = std::max(mach, P.velocity[p].norm() / c);
+    wave_ratio = std::max(wave_ratio, c / std::sqrt(material.p_wave_modulus() * P.reference_volume[p] / P.mass[p]));
+    double basis = 1.0;
+    if constexpr (requires { shape.cell_stretch(p); }) basis = 1.0 / std::min(1.0, shape.cell_stretch(p));
+    if constexpr (Shape::gradients_beyond_grid_basis) basis = std::max(basis, stiffening(shape, p, grid.h));
+    basis_stiffening = std::max(basis_stiffening, basis);
     const Mat2 s = shape.domain(p);
     if constexpr (has_domain) {
       const double area = std::abs(determinant(s));
@@ -90,6 +109,8 @@ Monitors monitor_particles(const Shape& shape, const Material& material, const P
   m.max_mach = mach;
   if constexpr (has_domain) m.max_distortion = distortion;
   m.near_edge = near;
+  m.max_wave_speed_ratio = wave_ratio;
+  m.max_basis_stiffening = basis_stiffening;
   return m;
 }
 
@@ -108,6 +129,8 @@ inline Monitors combined(const Monitors& a, const Monitors& b) {
                      : std::isnan(b.max_distortion) ? a.max_distortion
                                                     : std::max(a.max_distortion, b.max_distortion);
   m.near_edge = a.near_edge + b.near_edge;
+  m.max_wave_speed_ratio = std::max(a.max_wave_speed_ratio, b.max_wave_speed_ratio);
+  m.max_basis_stiffening = std::max(a.max_basis_stiffening, b.max_basis_stiffening);
   return m;
 }
 

@@ -135,10 +135,23 @@ class RestPoints {
     C_.resize(Eigen::Index(active_.size()), Eigen::Index(n));
     C_.setFromTriplets(entries.begin(), entries.end());
     if (active_.empty()) return;
-    const Eigen::SparseMatrix<double> S = C_ * inv_mass_.asDiagonal() * C_.transpose();
+    Eigen::SparseMatrix<double> S = C_ * inv_mass_.asDiagonal() * C_.transpose();
     solver_.compute(S);
-    if (solver_.info() != Eigen::Success)
-      throw std::runtime_error("rest points: the constraint system could not be factored");
+    // Rows can be redundant: two points whose only node with mass is the same
+    // node ask for the same thing, and S is singular but C v* lies in its
+    // range (range S = range C). The correction is then still unique, and
+    // (S + delta I) lambda = C v* gives it with C v = delta lambda, a residual
+    // of order delta / diag S = 1e-12 at the points.
+    const double largest = S.diagonal().cwiseAbs().maxCoeff();
+    const double pivot_floor = 1e-13 * largest;
+    if (solver_.info() != Eigen::Success || !(solver_.vectorD().minCoeff() > pivot_floor)) {
+      Eigen::SparseMatrix<double> shift(S.rows(), S.cols());
+      shift.setIdentity();
+      S += (1e-12 * largest) * shift;
+      solver_.compute(S);
+      if (solver_.info() != Eigen::Success)
+        throw std::runtime_error("rest points: the constraint system could not be factored");
+    }
   }
 
   std::vector<std::vector<std::pair<int, double>>> rows_;  // per point: (index into involved_, N_g(x_b))

@@ -180,6 +180,24 @@ TEST(Boundary, RestPointsHoldTheFieldAtRestNearestInKineticEnergy) {
     EXPECT_NEAR((g.velocity[i] - held.velocity[i]).norm(), 0.0, 1e-14);
 }
 
+// Two rest points whose only node with mass is the same node ask for the same
+// thing: their system C M^-1 C^T is singular (rank 1) but consistent, and the
+// projection still holds both, setting that node to rest, where a plain
+// factorization would give no finite multiplier and end the run.
+TEST(Boundary, RedundantRestPointsStillHoldTheField) {
+  GridFields g;
+  g.resize(8);
+  g.mass[5] = 2.0;
+  g.velocity[5] = Vec2(1.0, -2.0);
+  g.velocity[6] = Vec2(0.5, 0.25);  // no mass: not corrected
+  const std::vector<std::vector<std::pair<int, double>>> rows = {{{5, 0.6}, {6, 0.4}}, {{5, 0.3}, {7, 0.7}}};
+  mpmvv::RestPoints rest(rows, std::vector<unsigned char>(16, 0));
+  ASSERT_NO_THROW(rest.apply(g, 0.01));
+  EXPECT_NEAR(g.velocity[5].norm(), 0.0, 1e-10);
+  EXPECT_NEAR(g.acceleration[5].x(), -1.0 / 0.01, 1e-6);
+  EXPECT_EQ(g.velocity[6], Vec2(0.5, 0.25));
+}
+
 // A rest point where the grid basis would leave the grid is refused by name.
 TEST(Boundary, RestPointBeyondTheGridIsRefused) {
   const GridGeometry grid = GridGeometry::walled(Vec2(0.0, 0.0), 0.1, 12, 12);

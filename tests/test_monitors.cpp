@@ -132,6 +132,53 @@ TEST(Monitors, DistortionOfDomainsOnlyWherePointsHaveNone) {
                              .max_distortion));
 }
 
+// What lifts the CFL step's signal speed above c0 = sqrt((lambda + 2 mu) /
+// rho_0): an unstrained square domain lifts nothing (both 1); a neo-Hookean
+// particle stretched to F = diag(2, 1/2) (J = 1, sigma = mu (b - I), so
+// sigma_max = 3 mu) carries its waves at sqrt((lambda + 5 mu) / (lambda + 2 mu))
+// times c0; one swollen to F = diag(2, 1) with no stress, at half its density,
+// at sqrt(2 ((lambda + 2 |mu - lambda ln 2|) / 2) / (lambda + 2 mu)) times c0; a
+// CPDI domain sheared by 3 stiffens the basis by the CFL rule's own k_p, here
+// above 1.5; and under the total formulation a reference cell compressed to
+// half lifts the basis by 2.
+TEST(Monitors, WhatLiftsTheStepIsNamed) {
+  const mpmvv::GridGeometry grid = mpmvv::GridGeometry::walled(mpmvv::Vec2(-2.0, -2.0), 0.5, 8, 8);
+  const double lambda = 577.0, mu = 385.0;
+  const mpmvv::NeoHookean material{lambda, mu};
+  mpmvv::Particles P;
+  P.resize(1);
+  P.position[0] = P.reference_position[0] = mpmvv::Vec2(0.1, 0.05);
+  P.mass[0] = 1.0;
+  P.reference_volume[0] = P.volume[0] = 0.01;
+  P.half_size.assign(1, mpmvv::Vec2(0.05, 0.05));
+  const auto at_rest = mpmvv::monitor_particles(mpmvv::CpdiShape::bind(grid, P), material, P, grid);
+  EXPECT_DOUBLE_EQ(at_rest.max_wave_speed_ratio, 1.0);
+  EXPECT_DOUBLE_EQ(at_rest.max_basis_stiffening, 1.0);
+
+  P.deformation_gradient[0] << 2.0, 0.0, 0.0, 0.5;
+  P.stress[0] << 3.0 * mu, 0.0, 0.0, -0.75 * mu;
+  const auto stretched = mpmvv::monitor_particles(mpmvv::CpdiShape::bind(grid, P), material, P, grid);
+  EXPECT_NEAR(stretched.max_wave_speed_ratio, std::sqrt((lambda + 5.0 * mu) / (lambda + 2.0 * mu)), 1e-12);
+
+  P.deformation_gradient[0] << 2.0, 0.0, 0.0, 1.0;
+  P.stress[0].setZero();
+  P.volume[0] = 2.0 * P.reference_volume[0];
+  EXPECT_NEAR(mpmvv::monitor_particles(mpmvv::CpdiShape::bind(grid, P), material, P, grid).max_wave_speed_ratio,
+              std::sqrt((lambda + 2.0 * std::abs(mu - lambda * std::log(2.0))) / (lambda + 2.0 * mu)), 1e-12);
+  P.volume[0] = P.reference_volume[0];
+
+  P.deformation_gradient[0] << 1.0, 3.0, 0.0, 1.0;
+  const mpmvv::CpdiShape sheared = mpmvv::CpdiShape::bind(grid, P);
+  const double k = mpmvv::stiffening(sheared, 0, grid.h);
+  EXPECT_GT(k, 1.5);
+  EXPECT_DOUBLE_EQ(mpmvv::monitor_particles(sheared, material, P, grid).max_basis_stiffening, k);
+
+  P.deformation_gradient[0] << 0.5, 0.0, 0.0, 2.0;
+  EXPECT_NEAR(mpmvv::monitor_particles(mpmvv::TotalLagrangianCpdiShape::bind(grid, P), material, P, grid)
+                  .max_basis_stiffening,
+              2.0, 1e-12);
+}
+
 // The cell-averaged dilatation (eqs. 1.82-1.84) gives every particle of a cell
 // the cell's J = sum V / sum V0, keeps each cell's volume, and leaves the
 // isochoric part of F alone.
