@@ -88,7 +88,10 @@ class ExplicitStepper final : public Stepper {
     if (scheme_ == Scheme::musl) next_position_.resize(model_.particles.size());
     // The affine part starts at zero: the first map is FLIP's.
     if (apic_) model_.particles.affine_velocity.assign(model_.particles.size(), Mat2::Zero());
-    if (open_cos_ < 1.0) start_domain_axes(model_.particles);
+    // The shape's form was chosen from the same angle (make_for_geometry).
+    if ((open_cos_ < 1.0) != kTurnedDomains)
+      throw std::logic_error("min_domain_angle and the CPDI form it needs were chosen apart");
+    if constexpr (kTurnedDomains) start_domain_axes(model_.particles);
     if (dilatation_ != Dilatation::particle) volume_sums_.resize(std::size_t(max_threads()));
     if (damping_ > 0.0) fixed_components_ = prescribed_components(model_.grid.node_count(), constraints_);
     if (second_ > 0) {
@@ -108,7 +111,7 @@ class ExplicitStepper final : public Stepper {
     // Between steps, where no stage holds the particle arrays: domains are
     // turned first, and a split then halves the turned domain.
     if constexpr (Shape::reads_deformation_gradient) {
-      if (open_cos_ < 1.0) open_sheared_domains(model_.particles, open_cos_);
+      if constexpr (kTurnedDomains) open_sheared_domains(model_.particles, open_cos_);
       if (split_length_ > 0.0 && split_long_domains(model_.particles, split_length_) > 0) {
         if (scheme_ == Scheme::musl) next_position_.resize(model_.particles.size());
         if (body_force_) body_force_->prepare(model_.particles);
@@ -489,6 +492,10 @@ class ExplicitStepper final : public Stepper {
   Dilatation dilatation_;
   double split_length_;  // CPDI domains longer than this are split in two (split.hpp); 0: never
   double open_cos_;  // CPDI domains whose sides meet at |cos| above this are turned (domain_angle.hpp); 1: never
+  static constexpr bool kTurnedDomains = [] {
+    if constexpr (requires { Shape::turned_domains; }) return Shape::turned_domains;
+    return false;
+  }();
   double viscosity_linear_, viscosity_quadratic_;  // bulk viscosity C0, C1 (add_bulk_viscosity); 0: none
   double viscous_ratio_ = 0.0;                     // its damping ratio in the last step
   std::vector<double> volume_before_;              // with bulk viscosity: V_p before the deformation update

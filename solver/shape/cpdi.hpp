@@ -36,6 +36,7 @@ struct CpdiShapeT {
   static constexpr bool reads_deformation_gradient = true;
   static constexpr bool gradients_beyond_grid_basis = true;  // its corner interpolation (stages.hpp: stiffening)
   static constexpr bool has_domain = true;
+  static constexpr bool turned_domains = Turned;  // the stepper turns sheared domains (domain_angle.hpp)
   using GridBasis = LinearShapeT<G>;  // the corners read the hats
 
   // Natural coordinates of the corners, counter-clockwise (eq. 1.99 in 2D).
