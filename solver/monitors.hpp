@@ -47,7 +47,8 @@ struct Monitors {
   // What lifts the CFL step's signal speed above the body's small-strain wave
   // speed c0 = sqrt(p_wave_modulus / rho_0) (stages.hpp: scan_particles, whose
   // step is cfl h / max_p (max(c_p, k_p c0_p) + |v_p|), c0_p at the current
-  // density rho_0 / J_p): the particle's state, max c_p / c0 (a stretched
+  // density rho_0 / J_p; the total formulation's c_p / min(1, stretch) in
+  // place of c_p): the particle's state, max c_p / c0 (a stretched
   // neo-Hookean solid carries its waves faster along the stretch, and a
   // particle whose J has grown is lighter for the same stiffness), and the
   // basis, max k_p (CPDI's corner interpolation, stages.hpp: stiffening; for
