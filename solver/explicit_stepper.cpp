@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "domain_angle.hpp"
+#include "domain_corners.hpp"
 #include "rest_points.hpp"
 #include "split.hpp"
 #include "shape/cpdi.hpp"
@@ -92,6 +93,7 @@ class ExplicitStepper final : public Stepper {
     if ((open_cos_ < 1.0) != kTurnedDomains)
       throw std::logic_error("min_domain_angle and the CPDI form it needs were chosen apart");
     if constexpr (kTurnedDomains) start_domain_axes(model_.particles);
+    if constexpr (kCornerDomains) start_domain_corners(model_.particles);
     if (dilatation_ != Dilatation::particle) volume_sums_.resize(std::size_t(max_threads()));
     if (damping_ > 0.0) fixed_components_ = prescribed_components(model_.grid.node_count(), constraints_);
     if (second_ > 0) {
@@ -263,8 +265,19 @@ class ExplicitStepper final : public Stepper {
     move_tracers(dt);
     remember_volumes();
     velocities_from_grid<kVelocity | kPosition | kDeformation>(shape, fields_, dt, kick);
+    move_domain_corners(dt);
     update_stress_of_particles(dt);
     book_body_work(dt);
+  }
+
+  // Corner domains move with the velocity the particles just moved with, after
+  // the last transfer that weighs the step's domains; into `to` when those are
+  // still needed (MUSL), else in place.
+  void move_domain_corners(double dt, std::vector<Vec2>* to = nullptr) {
+    if constexpr (kCornerDomains) {
+      std::vector<Vec2>& corners = model_.particles.domain_corner;
+      move_corners(model_.grid, fields_, corners, to ? *to : corners, dt);
+    }
   }
 
   // USL for two bodies in contact (contact.hpp): each body maps to its own
@@ -335,6 +348,7 @@ class ExplicitStepper final : public Stepper {
     advance_grid(shape, t, dt, kick);
     move_tracers(dt);
     velocities_from_grid<kVelocity | kPosition>(shape, fields_, dt, kick);
+    move_domain_corners(dt);
     book_body_work(dt);
   }
 
@@ -347,6 +361,7 @@ class ExplicitStepper final : public Stepper {
     advance_grid(shape, t, dt, kick);
     move_tracers(dt);
     velocities_from_grid<kVelocity | kPosition>(shape, fields_, dt, kick, next_position_.data());
+    move_domain_corners(dt, &next_corner_);
     momentum_to_grid<kMomentum>(shape, fields_);
     grid_velocity_from_momentum(fields_);
     apply_walls(model_.grid, fields_);
@@ -355,6 +370,7 @@ class ExplicitStepper final : public Stepper {
     remember_volumes();
     grid_to_particles<kDeformation, Shape>(shape, fields_, P, dt, kick);
     P.position.swap(next_position_);
+    if constexpr (kCornerDomains) P.domain_corner.swap(next_corner_);
     update_stress_of_particles(dt);
     book_body_work(dt);
   }
@@ -496,6 +512,10 @@ class ExplicitStepper final : public Stepper {
     if constexpr (requires { Shape::turned_domains; }) return Shape::turned_domains;
     return false;
   }();
+  static constexpr bool kCornerDomains = [] {
+    if constexpr (requires { Shape::corner_domains; }) return Shape::corner_domains;
+    return false;
+  }();
   double viscosity_linear_, viscosity_quadratic_;  // bulk viscosity C0, C1 (add_bulk_viscosity); 0: none
   double viscous_ratio_ = 0.0;                     // its damping ratio in the last step
   std::vector<double> volume_before_;              // with bulk viscosity: V_p before the deformation update
@@ -516,6 +536,7 @@ class ExplicitStepper final : public Stepper {
   std::vector<std::vector<Vec2>> gradient_buffers_;
   ScatterBuffers buffers_;
   std::vector<Vec2> next_position_;  // MUSL only: x_{n+1} while x_n still sets the weights
+  std::vector<Vec2> next_corner_;    // MUSL with corner domains: the corners at t_{n+1}, likewise
   std::vector<Mat2> step_start_deformation_;  // USF with CPDI only: F_n, which sets the domains
   std::vector<Vec2> tracer_reference_;         // total Lagrangian: where each tracer reads the grid
 };
@@ -570,9 +591,12 @@ std::unique_ptr<Stepper> make_for_geometry(Model model, const SolverOptions& o, 
     case Method::linear: return make_for_shape<LinearShapeT<G>>(std::move(model), o, material, std::move(stages));
     case Method::gimp: return make_for_shape<GimpShapeT<G>>(std::move(model), o, material, std::move(stages));
     case Method::cpdi:
-      if constexpr (G == Geometry::plane_strain)
+      if constexpr (G == Geometry::plane_strain) {
         if (o.min_domain_angle > 0.0)
-          return make_for_shape<CpdiShapeT<G, true>>(std::move(model), o, material, std::move(stages));
+          return make_for_shape<CpdiShapeT<G, CpdiForm::turned>>(std::move(model), o, material, std::move(stages));
+        if (o.cpdi_domain == CpdiDomain::corners)
+          return make_for_shape<CpdiShapeT<G, CpdiForm::corners>>(std::move(model), o, material, std::move(stages));
+      }
       return make_for_shape<CpdiShapeT<G>>(std::move(model), o, material, std::move(stages));
     case Method::cpdi_exact:
       return make_for_shape<CpdiExactShapeT<G>>(std::move(model), o, material, std::move(stages));
@@ -644,6 +668,20 @@ std::unique_ptr<Stepper> make_stepper(Model model, const SolverOptions& options,
     if (options.formulation == Formulation::total)
       throw std::invalid_argument("min_domain_angle serves the updated formulation: total Lagrangian domains "
                                   "never deform");
+  }
+  if (options.cpdi_domain == CpdiDomain::corners) {
+    if (options.method != Method::cpdi) throw std::invalid_argument("cpdi_domain = corners is for method cpdi only");
+    if (options.geometry != Geometry::plane_strain)
+      throw std::invalid_argument("cpdi_domain = corners is plane strain only");
+    if (options.formulation == Formulation::total)
+      throw std::invalid_argument("cpdi_domain = corners serves the updated formulation: total Lagrangian domains "
+                                  "never deform");
+    if (options.min_domain_angle > 0.0)
+      throw std::invalid_argument("min_domain_angle turns parallelograms; corner domains (cpdi_domain = corners) "
+                                  "keep the quadrilateral their corners make");
+    if (stages.second_body > 0)
+      throw std::invalid_argument("cpdi_domain = corners serves one body (each body's corners would read its own "
+                                  "grid field)");
   }
   if (options.formulation == Formulation::total) {
     // What the reference grid cannot do yet, or does not need.

@@ -36,6 +36,10 @@ enum class Formulation { updated, total };
 // at every step.
 enum class VelocityTransfer { flip, apic };
 
+// CPDI's particle domains: the parallelograms F_p diag(l_p) of eq. 1.97, or
+// quadrilaterals whose corners move with the grid (domain_corners.hpp).
+enum class CpdiDomain { convected, corners };
+
 const char* to_string(Method m);
 const char* to_string(Scheme s);
 
@@ -60,6 +64,8 @@ struct SolverOptions {
   // is turned after a step, keeping its centroid, area and second moment of
   // area, until they meet at this angle (domain_angle.hpp); 0: never.
   double min_domain_angle = 0.0;
+  // CPDI only, updated formulation: the domains' description (CpdiDomain).
+  CpdiDomain cpdi_domain = CpdiDomain::convected;
   // Artificial bulk viscosity (002_c3305cb8b1bc1490.txt eqs. 1.66-1.67,
   // add_bulk_viscosity in stages.hpp): the linear and quadratic coefficients
   // C0 and C1; both 0: none.

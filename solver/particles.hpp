@@ -34,6 +34,12 @@ struct Particles {
   // current ones being F_p A_p. Empty otherwise, when A_p = diag(half_size).
   std::vector<Mat2> domain_axes;
 
+  // Optional, CPDI with corner domains only (domain_corners.hpp): each
+  // particle's four domain corners, 4 p + c counter-clockwise from
+  // (xi, eta) = (-1, -1), moved with the grid velocity like material points.
+  // Empty otherwise.
+  std::vector<Vec2> domain_corner;
+
   // Optional, exact CPDI only: a particle domain of any polygonal shape, the
   // reference outline's points relative to X_p (domain_vertex[domain_first[p]]
   // up to domain_first[p + 1]); its current outline is x_p + F_p (X_k - X_p).

@@ -15,13 +15,40 @@
 // tile their parent exactly in both configurations and together carry its
 // mass, momentum, kinetic and strain energy, and first moment of mass.
 // Plane strain only (in r-z the halves would not share the volume equally).
+//
+// Corner domains (domain_corners.hpp) are measured and cut by their corners:
+// r_i is the quadrilateral's half-vector [a_1 a_2] along i, and the halves
+// are the two quadrilaterals between the cut edges' midpoints, each keeping
+// the corners on its side; r_i and its reference a_i still place the halves'
+// centres as above.
 #pragma once
 
 #include <cstddef>
 
+#include "domain_corners.hpp"
 #include "particles.hpp"
 
 namespace mpmvv {
+
+// Corners 0-3 of particle p at (xi, eta) = (-1, -1), (1, -1), (1, 1), (-1, 1),
+// cut across `axis` (0: xi) at the midpoints of the two edges along it: p
+// keeps the minus half, and the plus half's corners are appended.
+inline void split_corners(std::vector<Vec2>& corners, std::size_t p, int axis) {
+  Vec2 x[4];
+  for (int c = 0; c < 4; ++c) x[c] = corners[4 * p + c];
+  Vec2 minus[4], plus[4];
+  if (axis == 0) {
+    const Vec2 m01 = 0.5 * (x[0] + x[1]), m32 = 0.5 * (x[3] + x[2]);
+    minus[0] = x[0], minus[1] = m01, minus[2] = m32, minus[3] = x[3];
+    plus[0] = m01, plus[1] = x[1], plus[2] = x[2], plus[3] = m32;
+  } else {
+    const Vec2 m03 = 0.5 * (x[0] + x[3]), m12 = 0.5 * (x[1] + x[2]);
+    minus[0] = x[0], minus[1] = x[1], minus[2] = m12, minus[3] = m03;
+    plus[0] = m03, plus[1] = m12, plus[2] = x[2], plus[3] = x[3];
+  }
+  for (int c = 0; c < 4; ++c) corners[4 * p + c] = minus[c];
+  for (int c = 0; c < 4; ++c) corners.push_back(plus[c]);
+}
 
 // Splits, in place, every particle whose domain length 2 |r_i| along either
 // vector exceeds `max_length`, as often as it takes (each half is checked
@@ -29,10 +56,11 @@ namespace mpmvv {
 inline std::size_t split_long_domains(Particles& P, double max_length) {
   std::size_t splits = 0;
   const bool turned = !P.domain_axes.empty();
+  const bool corners = !P.domain_corner.empty();
   for (std::size_t p = 0; p < P.size(); ++p) {
     for (;;) {
       const Mat2 a = P.reference_domain(p);
-      const Mat2 s = P.deformation_gradient[p] * a;
+      const Mat2 s = corners ? corner_half_vectors(&P.domain_corner[4 * p]) : Mat2(P.deformation_gradient[p] * a);
       const double long1 = 2.0 * s.col(0).norm(), long2 = 2.0 * s.col(1).norm();
       if (!(long1 > max_length || long2 > max_length)) break;  // NaN stays: the health scan reports it
       const int axis = long1 >= long2 ? 0 : 1;
@@ -50,6 +78,7 @@ inline std::size_t split_long_domains(Particles& P, double max_length) {
       } else {
         P.half_size[p][axis] = P.half_size[q][axis] = 0.5 * P.half_size[p][axis];
       }
+      if (corners) split_corners(P.domain_corner, p, axis);
       P.position[q] = P.position[p] + 0.5 * r;
       P.position[p] -= 0.5 * r;
       P.reference_position[q] = P.reference_position[p] + reference_step;

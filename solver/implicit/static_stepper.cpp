@@ -511,6 +511,8 @@ std::unique_ptr<Stepper> make_static_stepper(Model model, const SolverOptions& o
     throw std::invalid_argument("split_domains_beyond serves the explicit step only");
   if (options.min_domain_angle != 0.0)
     throw std::invalid_argument("min_domain_angle serves the explicit step only");
+  if (options.cpdi_domain != CpdiDomain::convected)
+    throw std::invalid_argument("cpdi_domain = corners serves the explicit step only");
   if (options.dilatation != Dilatation::particle)
     throw std::invalid_argument("the dilatation remedies (cell-averaged, node-smoothed) serve the explicit step only");
   if (options.bulk_viscosity_linear != 0.0 || options.bulk_viscosity_quadratic != 0.0)

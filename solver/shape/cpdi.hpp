@@ -14,22 +14,41 @@
 //   S_gp  = sum_c (1/4)(1 + (a xi_c + b eta_c) / (3 r_p)) S_g(x_c),
 //   G_gp  = s_p^-T sum_c ((xi_c/4)(1 + b eta_c / (3 r_p)), (eta_c/4)(1 + a xi_c / (3 r_p))) S_g(x_c),
 //   <S/r> = (1 / (4 r_p)) sum_c S_g(x_c).
+//
+// With corner domains (domain_corners.hpp, plane strain) the domain is the
+// quadrilateral of its four corners x_c, x = a_0 + a_1 xi + a_2 eta + a_3 xi eta,
+// whose Jacobian is det J = J0 + J1 xi + J2 eta (J0 = a_1 x a_2,
+// J1 = a_1 x a_3, J2 = a_3 x a_2) and area 4 J0. The bilinear corner function
+// phi_c integrates over it to J0 + (J1 xi_c + J2 eta_c) / 3 and its gradient
+// to (1/2) rot(x_{c+1} - x_{c-1}), rot(a) = (a_y, -a_x) (the divergence
+// theorem over the corner's two edges), which gives
+//   S_gp = sum_c (1/4)(1 + (J1 xi_c + J2 eta_c) / (3 J0)) S_g(x_c),
+//   G_gp = (1 / (8 J0)) sum_c rot(x_{c+1} - x_{c-1}) S_g(x_c);
+// for a parallelogram (a_3 = 0) these are the two lines above.
 #pragma once
 
 #include <algorithm>
 #include <cstddef>
 
+#include "../domain_corners.hpp"
 #include "../particles.hpp"
 #include "linear.hpp"
 #include "stencil.hpp"
 
 namespace mpmvv {
 
-// Turned: the domains are F_p A_p (Particles::domain_axes, domain_angle.hpp)
-// instead of F_p diag(l_p); a run that turns none steps the plain form, so
-// that the choice is made once per run, not once per particle.
-template <Geometry G, bool Turned = false>
+// The domain's form, chosen once per run, not once per particle:
+enum class CpdiForm {
+  convected,  // F_p diag(l_p)
+  turned,     // F_p A_p (Particles::domain_axes), held open under shear (domain_angle.hpp)
+  corners,    // the quadrilateral of Particles::domain_corner (domain_corners.hpp)
+};
+
+template <Geometry G, CpdiForm Form = CpdiForm::convected>
 struct CpdiShapeT {
+  static constexpr bool Turned = Form == CpdiForm::turned;
+  static constexpr bool Corners = Form == CpdiForm::corners;
+  static_assert(!Corners || G == Geometry::plane_strain, "corner domains are plane strain only");
   static constexpr int stencil_size = 16;  // four nodes for each of four corners, at most
   static constexpr const char* name = "cpdi";
   static constexpr Geometry geometry = G;
@@ -37,11 +56,12 @@ struct CpdiShapeT {
   static constexpr bool gradients_beyond_grid_basis = true;  // its corner interpolation (stages.hpp: stiffening)
   static constexpr bool has_domain = true;
   static constexpr bool turned_domains = Turned;  // the stepper turns sheared domains (domain_angle.hpp)
+  static constexpr bool corner_domains = Corners;  // the stepper moves the corners (domain_corners.hpp)
   using GridBasis = LinearShapeT<G>;  // the corners read the hats
 
   // Natural coordinates of the corners, counter-clockwise (eq. 1.99 in 2D).
-  static constexpr double corner_xi[4] = {-1.0, 1.0, 1.0, -1.0};
-  static constexpr double corner_eta[4] = {-1.0, -1.0, 1.0, 1.0};
+  static constexpr const double (&corner_xi)[4] = kCornerXi;
+  static constexpr const double (&corner_eta)[4] = kCornerEta;
 
   const GridGeometry* grid;
   const Vec2* position;
@@ -49,6 +69,7 @@ struct CpdiShapeT {
   const Vec2* half_size;
   const Mat2* domain_axes;  // Turned: A_p; else null, and the domains span diag(half_size)
   double gradient_scale;  // 1, but for a deliberate fault (SolverOptions::cpdi_gradient_scale)
+  const Vec2* corners;    // Corners: x_pc, four per particle (Particles::domain_corner); else null
 
   // The domains span F_p diag(l_p); `deformation_gradient` may point to a copy
   // of F taken at the start of a step, so that every transfer of the step uses
@@ -60,11 +81,14 @@ struct CpdiShapeT {
     return {&grid, particles.position.data(),
             deformation_gradient ? deformation_gradient : particles.deformation_gradient.data(),
             particles.half_size.data(),
-            Turned ? particles.domain_axes.data() : nullptr, gradient_scale};
+            Turned ? particles.domain_axes.data() : nullptr, gradient_scale,
+            Corners ? particles.domain_corner.data() : nullptr};
   }
 
-  // s_p = [r_1 r_2], the current domain half-vectors as columns (eq. 1.97).
+  // s_p = [r_1 r_2], the current domain half-vectors as columns (eq. 1.97);
+  // for corner domains the linear part [a_1 a_2] of their map.
   Mat2 domain(std::size_t p) const {
+    if constexpr (Corners) return corner_half_vectors(corners + 4 * p);
     Mat2 s = deformation_gradient ? deformation_gradient[p] : Mat2::Identity();
     if constexpr (Turned) {
       return s * domain_axes[p];
@@ -76,12 +100,34 @@ struct CpdiShapeT {
   }
 
   Vec2 corner(std::size_t p, const Mat2& s, int c) const {
+    if constexpr (Corners) return corners[4 * p + c];
     return position[p] + corner_xi[c] * s.col(0) + corner_eta[c] * s.col(1);
+  }
+
+  // Corner domains: the corner factors of S_gp and G_gp (above).
+  void quadrilateral_factors(std::size_t p, double* weight, Vec2* gradient) const {
+    const Vec2* x = corners + 4 * p;
+    const Mat2 s = corner_half_vectors(x);
+    const Vec2 a3 = 0.25 * (x[0] - x[1] + x[2] - x[3]);
+    const double J0 = determinant(s);
+    const double J1 = s(0, 0) * a3.y() - s(1, 0) * a3.x();
+    const double J2 = a3.x() * s(1, 1) - a3.y() * s(0, 1);
+    const double inv = gradient_scale / (8.0 * J0);
+    for (int c = 0; c < 4; ++c) {
+      weight[c] = 0.25 * (1.0 + (J1 * corner_xi[c] + J2 * corner_eta[c]) / (3.0 * J0));
+      const Vec2 d = x[(c + 1) % 4] - x[(c + 3) % 4];
+      gradient[c] = inv * Vec2(d.y(), -d.x());
+    }
   }
 
   // The corner factors of G_gp = sum_c S_g(x_c) g_c (above, with the r-z
   // weights), for the corners in the order of corner_xi, corner_eta.
   void corner_gradients(std::size_t p, const Mat2& s, Vec2* g) const {
+    if constexpr (Corners) {
+      double w[4];
+      quadrilateral_factors(p, w, g);
+      return;
+    }
     // s^-T = [[s11, -s10], [-s01, s00]] / det s.
     const double inv_det = gradient_scale / determinant(s);
     double weight_a = 0.0, weight_b = 0.0;
@@ -105,14 +151,19 @@ struct CpdiShapeT {
   // zero, so G_gp = sum_c (S_g(x_c) - S_g(x_p)) g_c, and over the nodes
   // sum_g |S_g(a) - S_g(b)| is at most 2 (|a_x - b_x| + |a_y - b_y|) / h
   // (the bilinear hats, each a product of 1D hats of slope 1 / h) and at
-  // most 2 (two partitions of unity).
+  // most 2 (two partitions of unity). Any point serves as b: the domain's
+  // centre (x_p, or a_0 for corner domains).
   double gradient_sum_bound(std::size_t p) const {
     const Mat2 s = domain(p);
     Vec2 g[4];
     corner_gradients(p, s, g);
+    Vec2 centre = Vec2::Zero();
+    if constexpr (Corners) centre = 0.25 * (corners[4 * p] + corners[4 * p + 1] + corners[4 * p + 2] + corners[4 * p + 3]);
     double bound = 0.0;
     for (int c = 0; c < 4; ++c) {
-      const Vec2 offset = corner_xi[c] * s.col(0) + corner_eta[c] * s.col(1);
+      Vec2 offset;
+      if constexpr (Corners) offset = corners[4 * p + c] - centre;
+      else offset = corner_xi[c] * s.col(0) + corner_eta[c] * s.col(1);
       bound += g[c].norm() * std::min(2.0, 2.0 * offset.cwiseAbs().sum() / grid->h);
     }
     return bound;
@@ -137,12 +188,14 @@ struct CpdiShapeT {
     int cell_i[4], cell_j[4];
     double fx[4], fy[4], corner_weight[4];
     Vec2 corner_gradient[4];
-    corner_gradients(p, s, corner_gradient);
+    if constexpr (Corners) quadrilateral_factors(p, corner_weight, corner_gradient);
+    else corner_gradients(p, s, corner_gradient);
     for (int c = 0; c < 4; ++c) {
-      const double xi = corner_xi[c], eta = corner_eta[c];
-      double cw = 0.25;
-      if constexpr (G == Geometry::axisymmetric) cw *= 1.0 + weight_a * xi + weight_b * eta;
-      corner_weight[c] = cw;
+      if constexpr (!Corners) {
+        double cw = 0.25;
+        if constexpr (G == Geometry::axisymmetric) cw *= 1.0 + weight_a * corner_xi[c] + weight_b * corner_eta[c];
+        corner_weight[c] = cw;
+      }
       const Vec2 x = grid_coordinate(g, corner(p, s, c));
       cell_i[c] = cell_index(x.x(), g.cells_x);
       cell_j[c] = cell_index(x.y(), g.cells_y);
@@ -211,6 +264,12 @@ struct CpdiShapeT {
     if constexpr (G == Geometry::axisymmetric)
       if (!(position[p].x() > 0.0)) return false;
     if (!inside_walls(*grid, position[p])) return false;
+    if constexpr (Corners) {
+      const Vec2* x = corners + 4 * p;
+      const Vec2 low = x[0].cwiseMin(x[1]).cwiseMin(x[2].cwiseMin(x[3]));
+      const Vec2 high = x[0].cwiseMax(x[1]).cwiseMax(x[2].cwiseMax(x[3]));
+      return inside_cells(*grid, grid_coordinate(*grid, low)) && inside_cells(*grid, grid_coordinate(*grid, high));
+    }
     // The corners x_p +- r_1 +- r_2 reach |r_1| + |r_2| along each axis: their
     // bounding box, without forming the four corners (the scan runs every step).
     const Vec2 reach = domain(p).cwiseAbs().rowwise().sum();

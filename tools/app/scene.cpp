@@ -72,6 +72,12 @@ std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_
        "is turned, keeping its centre, area and second moment of area, until they meet at this angle (0: never; "
        "solver/domain_angle.hpp); bounds the CPDI gradient, which grows as 1 / sin of that angle, under large shear",
        0.0, 89.0, false, false},
+      {"cpdi_domain", KeyKind::text, std::string("convected"),
+       "cpdi only, updated formulation, plane strain: convected (each domain the parallelogram F_p diag(l_p), "
+       "eq. 1.97) or corners (each domain the quadrilateral of four corners moved with the grid velocity, as the "
+       "particles are: neighbours keep sharing their corners, so the domains tile the body however it shears; "
+       "solver/domain_corners.hpp)",
+       -inf, inf, false, false, {"convected", "corners"}},
       {"bulk_viscosity", KeyKind::real, 0.0,
        "linear artificial bulk viscosity C0 (eq. 1.66 of the Vaango manual; 0.2 is typical, 0: none): a stress "
        "rho l C0 c tr(d) I, l the particle's thinnest width (at most h), that damps the particles' dilatation rate in "
@@ -133,6 +139,7 @@ SolverOptions solver_options(const Config& c) {
   o.velocity_transfer = c.text("velocity_transfer") == "apic" ? VelocityTransfer::apic : VelocityTransfer::flip;
   o.split_domains_beyond = c.real("split_domains_beyond");
   o.min_domain_angle = c.real("min_domain_angle");
+  o.cpdi_domain = c.text("cpdi_domain") == "corners" ? CpdiDomain::corners : CpdiDomain::convected;
   o.bulk_viscosity_linear = c.real("bulk_viscosity");
   o.bulk_viscosity_quadratic = c.real("bulk_viscosity_quadratic");
   return o;
