@@ -104,10 +104,10 @@ struct CpdiShapeT {
     return position[p] + corner_xi[c] * s.col(0) + corner_eta[c] * s.col(1);
   }
 
-  // Corner domains: the corner factors of S_gp and G_gp (above).
-  void quadrilateral_factors(std::size_t p, double* weight, Vec2* gradient) const {
+  // Corner domains: the corner factors of S_gp and G_gp (above), given the
+  // quadrilateral's linear part s = domain(p), which every caller has formed.
+  void quadrilateral_factors(std::size_t p, const Mat2& s, double* weight, Vec2* gradient) const {
     const Vec2* x = corners + 4 * p;
-    const Mat2 s = corner_half_vectors(x);
     const Vec2 a3 = 0.25 * (x[0] - x[1] + x[2] - x[3]);
     const double J0 = determinant(s);
     const double J1 = s(0, 0) * a3.y() - s(1, 0) * a3.x();
@@ -125,7 +125,7 @@ struct CpdiShapeT {
   void corner_gradients(std::size_t p, const Mat2& s, Vec2* g) const {
     if constexpr (Corners) {
       double w[4];
-      quadrilateral_factors(p, w, g);
+      quadrilateral_factors(p, s, w, g);
       return;
     }
     // s^-T = [[s11, -s10], [-s01, s00]] / det s.
@@ -188,7 +188,7 @@ struct CpdiShapeT {
     int cell_i[4], cell_j[4];
     double fx[4], fy[4], corner_weight[4];
     Vec2 corner_gradient[4];
-    if constexpr (Corners) quadrilateral_factors(p, corner_weight, corner_gradient);
+    if constexpr (Corners) quadrilateral_factors(p, s, corner_weight, corner_gradient);
     else corner_gradients(p, s, corner_gradient);
     for (int c = 0; c < 4; ++c) {
       if constexpr (!Corners) {

@@ -222,6 +222,17 @@ void write_particles(h5::Group& root, const Particles& P) {
   g.write("volume", V, {n});
   g.write("J", J, {n});
   g.write("deformation_gradient", F, {n, 2, 2});
+  // Corner domains (cpdi_domain = "corners") are whole quadrilaterals, not
+  // F_p times the reference half-vectors: store their corners so a reader can
+  // draw the domains the transfers used, counter-clockwise from (-1, -1).
+  if (P.domain_corner.size() == 4 * n && n > 0) {
+    std::vector<double> c(8 * n);
+    for (std::size_t k = 0; k < 4 * n; ++k) {
+      c[2 * k] = P.domain_corner[k].x();
+      c[2 * k + 1] = P.domain_corner[k].y();
+    }
+    g.write("domain_corners", c, {n, 4, 2});
+  }
 }
 
 }  // namespace mpmvv::app
