@@ -35,6 +35,10 @@ import numpy as np
 
 PARTICLE_NORMS = ("particle_L1", "particle_L2", "particle_Linf", "exact_displacement_L2")
 RELATIVE_NORMS = ("particle_relative_L2_integrated",)
+# Dimensionless, per particle like the displacement norms:
+#     particle_deformation_L2 = sqrt(sum_p V_p0 |F_p - F_exact(X_p, t)|^2 / sum_p V_p0)
+# (Frobenius, the out-of-plane stretch included).
+DEFORMATION_NORMS = ("particle_deformation_L2",)
 
 QUANTITY_UNITS = {
     "angular_displacement": "rad",
@@ -89,7 +93,7 @@ def norm_unit(norm, line_quantities):
     """Unit of an /errors column: m for particle norms, the line's quantity unit for L1_<line>."""
     if norm in PARTICLE_NORMS:
         return "m"
-    if norm in RELATIVE_NORMS:
+    if norm in RELATIVE_NORMS or norm in DEFORMATION_NORMS:
         return "1"
     quantity = line_quantities.get(norm[len("L1_"):]) if norm.startswith("L1_") else None
     return QUANTITY_UNITS.get(quantity, "")
@@ -105,6 +109,8 @@ def describe_norm(norm, line_quantities):
         return "largest particle displacement error"
     if norm == "exact_displacement_L2":
         return "volume-weighted RMS exact displacement (the scale of the particle errors)"
+    if norm == "particle_deformation_L2":
+        return "volume-weighted RMS error of each particle's deformation gradient F (Frobenius)"
     if norm == "particle_relative_L2_integrated":
         return "time-integrated relative L2 particle displacement error, from t = 0"
     if norm.startswith("L1_"):
