@@ -689,15 +689,16 @@ class MmsCase final : public SceneCase, private RunObserver {
       // carries an error of first order from particle to particle, which the
       // displacement norms average away.
       const std::size_t n = P.size();
-      const bool hoop = !P.hoop_stretch.empty();
+      const bool axisymmetric = setup_.geometry == Geometry::axisymmetric;  // F_33 = F_theta (out_of_plane_stretch)
       double pressure = 0.0, deformation = 0.0;
 #pragma omp parallel for schedule(static) reduction(+ : pressure, deformation)
       for (std::size_t p = 0; p < n; ++p) {
         const mms::ExactFields f = setup_.solution->fields(P.reference_position[p], t);
         const double e = 0.5 * ((P.stress[p] - f.cauchy_stress).trace());
         pressure += P.reference_volume[p] * e * e;
-        const double e33 = (hoop ? P.hoop_stretch[p] : 1.0) - f.hoop_stretch;
-        deformation += P.reference_volume[p] * ((P.deformation_gradient[p] - f.deformation_gradient).squaredNorm() + e33 * e33);
+        const double e33 = (axisymmetric ? P.hoop_stretch[p] : 1.0) - f.hoop_stretch;
+        const double e_in_plane = (P.deformation_gradient[p] - f.deformation_gradient).squaredNorm();
+        deformation += P.reference_volume[p] * (e_in_plane + e33 * e33);
       }
       errors_.columns[column++].second.push_back(std::sqrt(pressure / weight));
       errors_.columns[column++].second.push_back(std::sqrt(deformation / weight));
