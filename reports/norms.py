@@ -39,6 +39,9 @@ RELATIVE_NORMS = ("particle_relative_L2_integrated",)
 #     particle_deformation_L2 = sqrt(sum_p V_p0 |F_p - F_exact(X_p, t)|^2 / sum_p V_p0)
 # (Frobenius, the out-of-plane stretch included).
 DEFORMATION_NORMS = ("particle_deformation_L2",)
+# In m/s:
+#     particle_velocity_L2 = sqrt(sum_p V_p0 |v_p - v_exact(X_p, t)|^2 / sum_p V_p0)
+VELOCITY_NORMS = ("particle_velocity_L2",)
 
 QUANTITY_UNITS = {
     "angular_displacement": "rad",
@@ -95,6 +98,8 @@ def norm_unit(norm, line_quantities):
         return "m"
     if norm in RELATIVE_NORMS or norm in DEFORMATION_NORMS:
         return "1"
+    if norm in VELOCITY_NORMS:
+        return "m/s"
     quantity = line_quantities.get(norm[len("L1_"):]) if norm.startswith("L1_") else None
     return QUANTITY_UNITS.get(quantity, "")
 
@@ -111,6 +116,8 @@ def describe_norm(norm, line_quantities):
         return "volume-weighted RMS exact displacement (the scale of the particle errors)"
     if norm == "particle_deformation_L2":
         return "volume-weighted RMS error of each particle's deformation gradient F (Frobenius)"
+    if norm == "particle_velocity_L2":
+        return "volume-weighted RMS particle velocity error"
     if norm == "particle_relative_L2_integrated":
         return "time-integrated relative L2 particle displacement error, from t = 0"
     if norm.startswith("L1_"):

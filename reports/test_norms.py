@@ -50,4 +50,6 @@ def test_units_and_descriptions_follow_the_line_quantity():
     assert norms.norm_unit("L1_theta0", quantities) == "rad"
     assert norms.norm_unit("L1_line_y_mid", quantities) == "m"
     assert norms.norm_unit("particle_L2", quantities) == "m"
+    assert norms.norm_unit("particle_velocity_L2", quantities) == "m/s"
+    assert norms.norm_unit("particle_deformation_L2", quantities) == "1"
     assert "eq. 3.1" in norms.describe_norm("L1_theta0", quantities)
