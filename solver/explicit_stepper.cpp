@@ -241,6 +241,11 @@ class ExplicitStepper final : public Stepper {
                                               "B-spline support allows (half a cell quadratic, a cell cubic: it "
                                               "would reach the mirrored ghost nodes)",
                                               x.x(), x.y())};
+      if constexpr (requires { shape.folded(p); })
+        if (shape.folded(p))
+          return {"folded domain", fmt::format("the corner domain of the particle at ({:.6g}, {:.6g}) has turned over "
+                                               "(its corners bound no positive area)",
+                                               x.x(), x.y())};
       if constexpr (requires { shape.within_stencil(p); })
         if (!shape.within_stencil(p))
           return {"domain too wide", fmt::format("the domain of the particle at ({:.6g}, {:.6g}) spans more cells "
@@ -599,6 +604,9 @@ std::unique_ptr<Stepper> make_for_geometry(Model model, const SolverOptions& o, 
       }
       return make_for_shape<CpdiShapeT<G>>(std::move(model), o, material, std::move(stages));
     case Method::cpdi_exact:
+      if constexpr (G == Geometry::plane_strain)
+        if (o.cpdi_domain == CpdiDomain::corners)
+          return make_for_shape<CpdiExactShapeT<G, true>>(std::move(model), o, material, std::move(stages));
       return make_for_shape<CpdiExactShapeT<G>>(std::move(model), o, material, std::move(stages));
     case Method::bspline:
     case Method::bspline_cubic:
@@ -651,7 +659,9 @@ std::unique_ptr<Stepper> make_stepper(Model model, const SolverOptions& options,
     throw std::invalid_argument(fmt::format("method {} is plane strain only: in r-z a particle near the axis would "
                                             "weigh nodes at r < 0", to_string(options.method)));
   if (options.split_domains_beyond > 0.0) {
-    if (options.method != Method::cpdi) throw std::invalid_argument("split_domains_beyond is for method cpdi only");
+    if (options.method != Method::cpdi && !(options.method == Method::cpdi_exact && options.cpdi_domain == CpdiDomain::corners))
+      throw std::invalid_argument("split_domains_beyond is for method cpdi, or cpdi-exact with cpdi_domain = corners "
+                                  "(a split halves a parallelogram or a quadrilateral, not an outline)");
     if (options.geometry != Geometry::plane_strain)
       throw std::invalid_argument("split_domains_beyond is plane strain only");
     if (stages.second_body > 0) throw std::invalid_argument("split_domains_beyond serves one body only");
@@ -670,7 +680,8 @@ std::unique_ptr<Stepper> make_stepper(Model model, const SolverOptions& options,
                                   "never deform");
   }
   if (options.cpdi_domain == CpdiDomain::corners) {
-    if (options.method != Method::cpdi) throw std::invalid_argument("cpdi_domain = corners is for method cpdi only");
+    if (options.method != Method::cpdi && options.method != Method::cpdi_exact)
+      throw std::invalid_argument("cpdi_domain = corners is for methods cpdi and cpdi-exact");
     if (options.geometry != Geometry::plane_strain)
       throw std::invalid_argument("cpdi_domain = corners is plane strain only");
     if (options.formulation == Formulation::total)
@@ -736,6 +747,9 @@ std::unique_ptr<Stepper> make_stepper(Model model, const SolverOptions& options,
     throw std::invalid_argument(fmt::format("method {} needs a particle domain (half_size) for every particle",
                                             to_string(options.method)));
   check_domain_outlines(model.particles, options.method);
+  if (options.cpdi_domain == CpdiDomain::corners && !model.particles.domain_first.empty())
+    throw std::invalid_argument("corner domains replace particle outlines: seed them without outlines (the corners "
+                                "start from each particle's parallelogram)");
   if (bspline) {
     auto check = [&](const auto shape) {
       for (std::size_t p = 0; p < n; ++p)

@@ -4,7 +4,9 @@
 // where the domain crosses cell lines, agreement with the corner formula of
 // CPDI where it is exact (inside one cell), and particle outlines: an
 // outline equal to the parallelogram changes nothing, and two pieces on a
-// bridge integrate as the two pieces would.
+// bridge integrate as the two pieces would; corner domains: a quadrilateral
+// integrates as the same quadrilateral given as an outline, a crossed one as
+// the parallelogram of its linear part, and one turned over is not inside.
 #include <gtest/gtest.h>
 
 #include "support.hpp"
@@ -14,6 +16,7 @@
 #include <random>
 #include <vector>
 
+#include "solver/domain_corners.hpp"
 #include "solver/particles.hpp"
 #include "solver/shape/cpdi.hpp"
 #include "solver/shape/cpdi_exact.hpp"
@@ -70,6 +73,16 @@ std::map<int, NodeValues> stencil_of(const GridGeometry& grid, const Particles& 
   Stencil<Shape::stencil_size> s;
   shape.evaluate(p, s);
   return by_node(s);
+}
+
+// Two stencils list the same nodes with the same weights and gradients.
+void expect_same_stencil(const std::map<int, NodeValues>& got, const std::map<int, NodeValues>& expected, double h) {
+  ASSERT_EQ(got.size(), expected.size());
+  for (const auto& [node, e] : expected) {
+    ASSERT_TRUE(got.count(node)) << "node " << node;
+    EXPECT_NEAR(got.at(node).weight, e.weight, 1e-14);
+    EXPECT_LT((got.at(node).gradient - e.gradient).norm() * h, 1e-13);
+  }
 }
 
 // The tent of node (i, j) and its gradient at x, straight from its definition.
@@ -192,12 +205,7 @@ TEST(CpdiExactShape, OutlineOfTheParallelogramChangesNothing) {
   const std::map<int, NodeValues> before = stencil_of<CpdiExactShape>(grid, P);
   P.domain_first = {0, 4};
   P.domain_vertex = {Vec2(-l.x(), -l.y()), Vec2(l.x(), -l.y()), Vec2(l.x(), l.y()), Vec2(-l.x(), l.y())};
-  const std::map<int, NodeValues> after = stencil_of<CpdiExactShape>(grid, P);
-  ASSERT_EQ(before.size(), after.size());
-  for (const auto& [node, b] : before) {
-    EXPECT_NEAR(after.at(node).weight, b.weight, 1e-14);
-    EXPECT_LT((after.at(node).gradient - b.gradient).norm() * grid.h, 1e-13);
-  }
+  expect_same_stencil(stencil_of<CpdiExactShape>(grid, P), before, grid.h);
 }
 
 // Two pieces on a bridge (a square and a triangle apart from it, across a
@@ -248,6 +256,70 @@ TEST(CpdiExactShape, DomainBeyondThreeCellsIsNotInside) {
   const Particles too_long = one_particle(x, stretch, grid.h * Vec2(0.25, 0.25));  // 3.25 cells long
   EXPECT_TRUE(CpdiExactShape::bind(grid, fits).inside(0));
   EXPECT_FALSE(CpdiExactShape::bind(grid, too_long).inside(0));
+}
+
+// Corner domains (cpdi_domain = "corners"): the particle's own four corners.
+using CornerExactShape = mpmvv::CpdiExactShapeT<mpmvv::Geometry::plane_strain, true>;
+
+Particles with_corners(const Particles& base, const std::vector<Vec2>& corners) {
+  Particles P = base;
+  P.domain_corner = corners;
+  return P;
+}
+
+// A quadrilateral that is no parallelogram (one reflex corner, across two
+// cell lines) integrates exactly as the outline of the same four points does,
+// and a parallelogram's corners as the parallelogram F_p diag(l_p).
+TEST(CpdiExactShape, CornerDomainIntegratesItsQuadrilateral) {
+  const GridGeometry grid = grid_of(0.25);
+  Mat2 F;
+  F << 1.1, 0.4, -0.2, 0.9;
+  const Vec2 l(0.09, 0.07);
+  const Particles P = one_particle(grid.origin + Vec2(1.37, 1.52), F, l);
+  mpmvv::Particles started = P;
+  mpmvv::start_domain_corners(started);
+  expect_same_stencil(stencil_of<CornerExactShape>(grid, started), stencil_of<CpdiExactShape>(grid, P), grid.h);
+  const Vec2 x = P.position[0];
+  // Counter-clockwise, the corner at (+,+) pulled in past the diagonal: reflex.
+  const std::vector<Vec2> quad = {x + Vec2(-0.1, -0.08), x + Vec2(0.12, -0.06), x + Vec2(-0.01, 0.0),
+                                  x + Vec2(-0.09, 0.11)};
+  const Particles reflex = with_corners(P, quad);
+  const CornerExactShape shape = CornerExactShape::bind(grid, reflex);
+  EXPECT_TRUE(shape.inside(0));
+  EXPECT_FALSE(CornerExactShape::crossed(quad.data()));
+  Particles outlined = P;
+  outlined.deformation_gradient[0] = Mat2::Identity();
+  outlined.domain_first = {0, 4};
+  for (const Vec2& c : quad) outlined.domain_vertex.push_back(c - x);
+  expect_same_stencil(stencil_of<CornerExactShape>(grid, reflex), stencil_of<CpdiExactShape>(grid, outlined), grid.h);
+}
+
+// A bow tie (corners 2 and 3 swapped past each other, positive signed area
+// left) integrates as the parallelogram a_0 +- a_1 +- a_2 of its linear part;
+// a quadrilateral turned over (clockwise) is folded and not inside.
+TEST(CpdiExactShape, CrossedCornerDomainTakesItsParallelogramAndATurnedOneStops) {
+  const GridGeometry grid = grid_of(0.25);
+  const Particles P = one_particle(grid.origin + Vec2(1.37, 1.52), Mat2::Identity(), Vec2(0.08, 0.08));
+  const Vec2 x = P.position[0];
+  const std::vector<Vec2> bow = {x + Vec2(-0.1, -0.04), x + Vec2(0.12, -0.04), x + Vec2(-0.02, 0.04),
+                                 x + Vec2(0.06, 0.02)};
+  ASSERT_TRUE(CornerExactShape::crossed(bow.data()));
+  const Mat2 s = mpmvv::corner_half_vectors(bow.data());
+  ASSERT_GT(mpmvv::determinant(s), 0.0);
+  const Vec2 a0 = 0.25 * (bow[0] + bow[1] + bow[2] + bow[3]);
+  std::vector<Vec2> parallelogram;
+  for (int c = 0; c < 4; ++c) parallelogram.push_back(a0 + mpmvv::kCornerXi[c] * s.col(0) + mpmvv::kCornerEta[c] * s.col(1));
+  expect_same_stencil(stencil_of<CornerExactShape>(grid, with_corners(P, bow)),
+                      stencil_of<CornerExactShape>(grid, with_corners(P, parallelogram)), grid.h);
+  const Particles bowed = with_corners(P, bow);
+  const CornerExactShape crossed = CornerExactShape::bind(grid, bowed);
+  EXPECT_FALSE(crossed.folded(0));
+  EXPECT_TRUE(crossed.inside(0));
+  const std::vector<Vec2> turned = {parallelogram[0], parallelogram[3], parallelogram[2], parallelogram[1]};
+  const Particles turned_over = with_corners(P, turned);
+  const CornerExactShape over = CornerExactShape::bind(grid, turned_over);
+  EXPECT_TRUE(over.folded(0));
+  EXPECT_FALSE(over.inside(0));
 }
 
 }  // namespace

@@ -856,14 +856,16 @@ TEST(CpdiCorners, CornersFollowAnAffineGridMotion) {
 // Under a shearing, stretching motion the corners that neighbouring
 // particles share at the start stay shared, so the domains keep tiling the
 // disk, while each particle's parallelogram F_p diag(l_p) leaves its
-// neighbours'; the corners moved in earnest.
+// neighbours'; the corners moved in earnest. The same under exact CPDI, which
+// integrates the hats over the quadrilaterals the stepper moves alike.
 TEST(CpdiCorners, NeighboursKeepSharingTheirCornersUnderShear) {
+  for (Method method : {Method::cpdi, Method::cpdi_exact})
   for (Scheme scheme : kSchemes) {
-    SCOPED_TRACE(to_string(scheme));
-    Model model = disk_model(Method::cpdi);
+    SCOPED_TRACE(to_string(method) + std::string(" ") + to_string(scheme));
+    Model model = disk_model(method);
     shear_and_stretch(model);
     const double dt = stable_step(model);
-    SolverOptions options{Method::cpdi, scheme};
+    SolverOptions options{method, scheme};
     options.cpdi_domain = mpmvv::CpdiDomain::corners;
     auto stepper = mpmvv::make_stepper(std::move(model), options, MaterialModel{kSolid}, nullptr);
     const std::vector<Vec2> start = stepper->model().particles.domain_corner;
@@ -894,7 +896,7 @@ TEST(CpdiCorners, NeighboursKeepSharingTheirCornersUnderShear) {
     EXPECT_LT(apart, 1e-14);
     EXPECT_GT(moved, 1e-3);
     EXPECT_GT(convected_apart, 1e3 * std::max(apart, 1e-16));
-    RecordProperty(std::string("convected_gap_") + to_string(scheme), scientific(convected_apart));
+    RecordProperty(std::string("convected_gap_") + to_string(method) + "_" + to_string(scheme), scientific(convected_apart));
   }
 }
 
@@ -953,6 +955,23 @@ TEST(CpdiCorners, MakeStepperRefusesCornersElsewhere) {
   SolverOptions split = options(Method::cpdi);
   split.split_domains_beyond = 0.5;
   EXPECT_NO_THROW(mpmvv::make_stepper(disk_model(Method::cpdi), split, MaterialModel{kSolid}, nullptr));
+  // Exact CPDI splits corner domains, not its parallelograms (their outlines
+  // would not follow), and corner domains replace particle outlines.
+  SolverOptions exact_split = options(Method::cpdi_exact);
+  exact_split.split_domains_beyond = 0.5;
+  EXPECT_NO_THROW(mpmvv::make_stepper(disk_model(Method::cpdi_exact), exact_split, MaterialModel{kSolid}, nullptr));
+  exact_split.cpdi_domain = mpmvv::CpdiDomain::convected;
+  EXPECT_THROW(mpmvv::make_stepper(disk_model(Method::cpdi_exact), exact_split, MaterialModel{kSolid}, nullptr),
+               std::invalid_argument);
+  Model outlined = disk_model(Method::cpdi_exact);
+  const double l = outlined.particles.half_size[0].x();
+  outlined.particles.domain_first.assign(outlined.particles.size() + 1, 0);
+  for (std::size_t p = 0; p < outlined.particles.size(); ++p) {
+    for (const Vec2& v : {Vec2(-l, -l), Vec2(l, -l), Vec2(l, l), Vec2(-l, l)}) outlined.particles.domain_vertex.push_back(v);
+    outlined.particles.domain_first[p + 1] = std::uint32_t(outlined.particles.domain_vertex.size());
+  }
+  EXPECT_THROW(mpmvv::make_stepper(std::move(outlined), options(Method::cpdi_exact), MaterialModel{kSolid}, nullptr),
+               std::invalid_argument);
 }
 
 // Exact CPDI's stencil holds 3 x 3 cells: a particle stretched beyond them

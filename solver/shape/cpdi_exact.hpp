@@ -10,6 +10,16 @@
 // the boundary carries stress (a tangential stress on a curved rim) the nodal
 // force keeps an error of relative size (l / h)^2 that does not fall with h.
 //
+// With corner domains (cpdi_domain = "corners", solver/domain_corners.hpp,
+// plane strain) the domain is the quadrilateral of the particle's four
+// corners, integrated the same way. The corner interpolation of cpdi.hpp
+// reads the hats at the corners only, so a domain whose corners straddle a
+// cell line averages the hat's kink with the trapezoid rule; where the shear
+// runs along a grid line the particles keep their place across the line for
+// the whole passage, the error does not average out from step to step, and
+// the ring keeps a residual rotation whose size scales with the domain
+// against the cell (suites/stiff-vortex.toml, study "updated-exact").
+//
 // The integration: the domain is clipped to every cell it meets (Sutherland-
 // Hodgman against the cell's four sides, in grid coordinates), and on each
 // piece the moments int 1, int u, int v, int u v (u, v the coordinates in the
@@ -30,6 +40,7 @@
 #include <cstdint>
 #include <cstddef>
 
+#include "../domain_corners.hpp"
 #include "../particles.hpp"
 #include "linear.hpp"
 #include "stencil.hpp"
@@ -92,8 +103,9 @@ inline int clip_polygon(const Vec2* in, int count, int axis, double bound, bool 
   return n;
 }
 
-template <Geometry G>
+template <Geometry G, bool Corners = false>
 struct CpdiExactShapeT {
+  static_assert(!Corners || G == Geometry::plane_strain, "corner domains are plane strain only");
   static constexpr int block = 4;                       // nodes per direction the domain may reach
   static constexpr int stencil_size = block * block;
   // Points of a particle's own outline: a cut piece has its sub-cell's
@@ -106,6 +118,7 @@ struct CpdiExactShapeT {
   static constexpr bool reads_deformation_gradient = true;
   static constexpr bool gradients_beyond_grid_basis = false;  // exact averages of the grid basis
   static constexpr bool has_domain = true;
+  static constexpr bool corner_domains = Corners;  // the stepper moves the corners (domain_corners.hpp)
   using GridBasis = LinearShapeT<G>;  // the domain averages the hats
 
   const GridGeometry* grid;
@@ -115,6 +128,7 @@ struct CpdiExactShapeT {
   const std::uint32_t* domain_first;  // null when no particle has an outline of its own
   const Vec2* domain_vertex;
   double gradient_scale;  // 1, but for a deliberate fault (SolverOptions::cpdi_gradient_scale)
+  const Vec2* corners;    // Corners: x_pc, four per particle (Particles::domain_corner); else null
 
   static CpdiExactShapeT bind(const GridGeometry& grid, const Particles& particles,
                               const Mat2* deformation_gradient = nullptr, double gradient_scale = 1.0) {
@@ -125,7 +139,8 @@ struct CpdiExactShapeT {
             particles.half_size.data(),
             outlines ? particles.domain_first.data() : nullptr,
             outlines ? particles.domain_vertex.data() : nullptr,
-            gradient_scale};
+            gradient_scale,
+            Corners ? particles.domain_corner.data() : nullptr};
   }
 
   // The map of the domain from the reference: F_p, or I when
@@ -133,8 +148,10 @@ struct CpdiExactShapeT {
   // Lagrangian formulation, total_lagrangian.hpp).
   Mat2 domain_map(std::size_t p) const { return deformation_gradient ? deformation_gradient[p] : Mat2::Identity(); }
 
-  // s_p = [r_1 r_2], the current domain half-vectors as columns (eq. 1.97).
+  // s_p = [r_1 r_2], the current domain half-vectors as columns (eq. 1.97);
+  // for corner domains the linear part [a_1 a_2] of their map.
   Mat2 domain(std::size_t p) const {
+    if constexpr (Corners) return corner_half_vectors(corners + 4 * p);
     Mat2 s = domain_map(p);
     s.col(0) *= half_size[p].x();
     s.col(1) *= half_size[p].y();
@@ -145,6 +162,22 @@ struct CpdiExactShapeT {
   // det F > 0: the particle's own outline (Particles::domain_vertex) mapped by
   // F_p, or the parallelogram's four corners. Returns the number of points.
   int outline(std::size_t p, Vec2* c) const {
+    if constexpr (Corners) {
+      // A crossed quadrilateral (a thin domain whose corners the grid
+      // velocity has turned past each other) is integrated as the
+      // parallelogram of its linear part, a_0 +- a_1 +- a_2: the same centre
+      // and area, counter-clockwise while the area is positive. Its corners
+      // stay as they are, shared with its neighbours.
+      const Vec2* x = corners + 4 * p;
+      if (crossed(x)) {
+        const Mat2 s = corner_half_vectors(x) / grid->h;
+        const Vec2 a0 = grid_coordinate(*grid, 0.25 * (x[0] + x[1] + x[2] + x[3]));
+        for (int k = 0; k < 4; ++k) c[k] = a0 + kCornerXi[k] * s.col(0) + kCornerEta[k] * s.col(1);
+        return 4;
+      }
+      for (int k = 0; k < 4; ++k) c[k] = grid_coordinate(*grid, x[k]);
+      return 4;
+    }
     const Vec2 x = grid_coordinate(*grid, position[p]);
     if (domain_first != nullptr && domain_first[p + 1] > domain_first[p]) {
       const Mat2 F = domain_map(p) / grid->h;
@@ -268,9 +301,33 @@ struct CpdiExactShapeT {
     if (!inside_walls(*grid, position[p])) return false;
     if constexpr (G == Geometry::axisymmetric)
       if (!(position[p].x() > 0.0)) return false;
+    if constexpr (Corners)
+      if (folded(p)) return false;
     Vec2 lo, hi;
     outline_box(p, lo, hi);
     return inside_cells(*grid, lo) && inside_cells(*grid, hi) && within_block(lo, hi);
+  }
+
+  // A corner domain turned over: its signed area, 4 det [a_1 a_2], is not
+  // positive. No outline of it bounds the material, so its particle stops the
+  // run (the reason "folded domain").
+  bool folded(std::size_t p) const {
+    if constexpr (Corners) return !(determinant(corner_half_vectors(corners + 4 * p)) > 0.0);
+    return false;
+  }
+
+  // Whether a quadrilateral crosses itself (a bow tie: two opposite edges
+  // meet). A quadrilateral with one reflex corner is simple and integrates
+  // exactly; a crossed one does not (its two lobes enter with opposite signs).
+  static bool crossed(const Vec2* x) {
+    auto cross = [](const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); };
+    // Segments ab and cd meet where each separates the other's ends.
+    auto meet = [&](const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d) {
+      const double c1 = cross(b - a, c - a), c2 = cross(b - a, d - a);
+      const double c3 = cross(d - c, a - c), c4 = cross(d - c, b - c);
+      return ((c1 > 0.0) != (c2 > 0.0)) && ((c3 > 0.0) != (c4 > 0.0));
+    };
+    return meet(x[0], x[1], x[2], x[3]) || meet(x[1], x[2], x[3], x[0]);
   }
 
   // Whether the domain fits the 3 x 3 cells of the stencil (a domain stretched

@@ -379,7 +379,10 @@ class MmsCase final : public SceneCase, private RunObserver {
   // Exact CPDI domains follow a clipped piece's outline, arcs in chords of a
   // quarter of the particle spacing (the chord's sagitta, spacing^2 / (128 R),
   // is far below what a piece's area can tell).
-  bool outlines() const { return options_.method == Method::cpdi_exact && exact_seeding_; }
+  // Corner domains start from each particle's parallelogram (domain_corners.hpp).
+  bool outlines() const {
+    return options_.method == Method::cpdi_exact && options_.cpdi_domain != CpdiDomain::corners && exact_seeding_;
+  }
 
   // The outline of a piece and a sliver joined to it: a whole sub-cell's
   // square where either has none, then the sliver's ring on a bridge

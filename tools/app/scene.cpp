@@ -63,9 +63,9 @@ std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_
        "the rest is damped every step; updated formulation, plane strain; solver/model.hpp)",
        -inf, inf, false, false, {"flip", "apic"}},
       {"split_domains_beyond", KeyKind::real, 0.0,
-       "cpdi only: after a step, a particle whose domain is longer than this many cells along one of its vectors is "
-       "replaced by its two halves along it (0: never); keeps the corner interpolation of CPDI within a few cells "
-       "under large shear",
+       "cpdi, and cpdi-exact with corner domains: after a step, a particle whose domain is longer than this many "
+       "cells along one of its vectors is replaced by its two halves along it (0: never); keeps the corner "
+       "interpolation of CPDI within a few cells under large shear",
        0.0, 1000.0, false, false},
       {"min_domain_angle", KeyKind::real, 0.0,
        "cpdi only, updated formulation: after a step, a domain whose sides meet at less than this angle [degrees] "
@@ -73,10 +73,10 @@ std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_
        "solver/domain_angle.hpp); bounds the CPDI gradient, which grows as 1 / sin of that angle, under large shear",
        0.0, 89.0, false, false},
       {"cpdi_domain", KeyKind::text, std::string("convected"),
-       "cpdi only, updated formulation, plane strain: convected (each domain the parallelogram F_p diag(l_p), "
-       "eq. 1.97) or corners (each domain the quadrilateral of four corners moved with the grid velocity, as the "
-       "particles are: neighbours keep sharing their corners, so the domains tile the body however it shears; "
-       "solver/domain_corners.hpp)",
+       "cpdi and cpdi-exact, updated formulation, plane strain: convected (each domain the parallelogram F_p "
+       "diag(l_p), eq. 1.97) or corners (each domain the quadrilateral of four corners moved with the grid velocity, "
+       "as the particles are: neighbours keep sharing their corners, so the domains tile the body however it shears; "
+       "solver/domain_corners.hpp; cpdi-exact integrates the hats over the quadrilateral itself)",
        -inf, inf, false, false, {"convected", "corners"}},
       {"bulk_viscosity", KeyKind::real, 0.0,
        "linear artificial bulk viscosity C0 (eq. 1.66 of the Vaango manual; 0.2 is typical, 0: none): a stress "
