@@ -653,6 +653,16 @@ def health_figure(study, all_series, directory):
         caption += (f" {len(chosen)} of the {len(found)} cases with monitors are drawn: for each method the finest "
                     f"completed case and the finest case that did not complete (the earliest failure on a tie); the "
                     f"stability map shows every case.")
+    folded = []
+    for series, case, monitors in found:
+        counts = monitors.column("folded_domains")
+        if np.any(counts > 0):  # NaN (a file without the column) compares False
+            first = int(np.argmax(counts > 0))
+            folded.append(f"{health_label(series, case, monitors)[0]}: {int(np.nanmax(counts))} at most, from "
+                          f"{time_text(float(monitors.time[first]))}")
+    if folded:
+        caption += (" CPDI corner domains turned over (folded_domains; their corners no longer bound the material, "
+                    "results-format.md) in " + "; ".join(folded) + ".")
     if without:
         caption += f" {without} case(s) of the study have results without /probes/monitors (written before them)."
     return FigureEntry(study, path, caption)

@@ -225,3 +225,26 @@ def test_what_slows_the_step_gets_its_panel(tmp_path, drawn):
     assert "the particle's state and density, max c_p / c0 (solid), and the basis, max k_p" in written["markdown"].read_text()
     assert len(figures.run_health(ring, "with what slows the step").axes) == 5
     assert len(figures.run_health(cylinder, "without").axes) == 4
+
+
+@needs_gold
+def test_folded_corner_domains_are_named_in_the_caption(tmp_path, drawn):
+    """Requirement: a case whose results file counts CPDI corner domains turned over
+    (folded_domains > 0 at some output time) is named in its study's run-health
+    caption with the largest count and the first output time it was seen; a study
+    whose counts are all zero, or whose files have no such column, names none."""
+    directory = gold_with_results(tmp_path / "suite", monitors_in=("ring", "rz-cylinder"))
+    for path in (directory / "cases").glob("ring-method=*.h5"):
+        with h5py.File(path, "a") as f:
+            group = f["probes/monitors"]
+            t = group["time"][:]
+            folded = "method=cpdi" in path.name and "cells=64" in path.name
+            group["folded_domains"] = np.where(t >= t[-1], 4.0, 0.0) if folded else 0.0 * t
+    written, _ = report.write_report(directory, tmp_path / "out")
+    markdown = written["markdown"].read_text()
+    ring_caption = next(line for line in markdown.splitlines() if line.startswith("_ring: the run's health"))
+    assert "CPDI corner domains turned over (folded_domains" in ring_caption
+    assert "in method=cpdi, cells=64: 4 at most, from t = " in ring_caption
+    assert "cells=32: " not in ring_caption.split("turned over")[1]
+    cylinder_caption = next(line for line in markdown.splitlines() if line.startswith("_rz-cylinder: the run's health"))
+    assert "turned over" not in cylinder_caption

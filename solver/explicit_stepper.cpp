@@ -241,11 +241,6 @@ class ExplicitStepper final : public Stepper {
                                               "B-spline support allows (half a cell quadratic, a cell cubic: it "
                                               "would reach the mirrored ghost nodes)",
                                               x.x(), x.y())};
-      if constexpr (requires { shape.folded(p); })
-        if (shape.folded(p))
-          return {"folded domain", fmt::format("the corner domain of the particle at ({:.6g}, {:.6g}) has turned over "
-                                               "(its corners bound no positive area)",
-                                               x.x(), x.y())};
       if constexpr (requires { shape.within_stencil(p); })
         if (!shape.within_stencil(p))
           return {"domain too wide", fmt::format("the domain of the particle at ({:.6g}, {:.6g}) spans more cells "

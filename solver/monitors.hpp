@@ -44,6 +44,11 @@ struct Monitors {
   // (NaN without domains: linear MPM).
   double max_distortion = std::numeric_limits<double>::quiet_NaN();
   std::size_t near_edge = 0;   // particles whose domain reaches past the middle of the grid's outermost cell layer
+  // Corner domains (domain_corners.hpp) turned over, 4 det [a_1 a_2] <= 0: the
+  // exact CPDI integrates such a particle over its own parallelogram F_p A_p,
+  // the corner interpolation over the turned quadrilateral as it stands
+  // (cpdi_exact.hpp, cpdi.hpp: folded). 0 for every other domain.
+  std::size_t folded_domains = 0;
   // What lifts the CFL step's signal speed above the body's small-strain wave
   // speed c0 = sqrt(p_wave_modulus / rho_0) (stages.hpp: scan_particles, whose
   // step is cfl h / max_p (max(c_p, k_p c0_p) + |v_p|), c0_p at the current
@@ -68,9 +73,9 @@ Monitors monitor_particles(const Shape& shape, const Material& material, const P
   const std::size_t n = std::min(end, P.size());
   double kinetic = 0.0, strain = 0.0, min_J = m.min_J, max_J = 0.0, mach = 0.0, spin = 0.0;
   double distortion = 0.0, wave_ratio = 0.0, basis_stiffening = 0.0;
-  std::size_t near = 0;
+  std::size_t near = 0, folded = 0;
   constexpr bool has_domain = Shape::has_domain;
-#pragma omp parallel for schedule(static) reduction(+ : kinetic, strain, near, spin) reduction(min : min_J) \
+#pragma omp parallel for schedule(static) reduction(+ : kinetic, strain, near, folded, spin) reduction(min : min_J) \
     reduction(max : max_J, mach, distortion, wave_ratio, basis_stiffening)
   for (std::size_t p = begin; p < n; ++p) {
     const double F33 = out_of_plane_stretch<Shape::geometry>(P, p);
@@ -101,6 +106,8 @@ Monitors monitor_particles(const Shape& shape, const Material& material, const P
         edge = edge || !(xi.x() >= 0.5 && xi.y() >= 0.5 && xi.x() <= grid.cells_x - 0.5 && xi.y() <= grid.cells_y - 0.5);
       }
     if (edge) ++near;
+    if constexpr (requires { shape.folded(p); })
+      if (shape.folded(p)) ++folded;
   }
   m.kinetic = kinetic;
   if constexpr (Shape::geometry == Geometry::plane_strain) m.angular_momentum = spin;
@@ -110,6 +117,7 @@ Monitors monitor_particles(const Shape& shape, const Material& material, const P
   m.max_mach = mach;
   if constexpr (has_domain) m.max_distortion = distortion;
   m.near_edge = near;
+  m.folded_domains = folded;
   m.max_wave_speed_ratio = wave_ratio;
   m.max_basis_stiffening = basis_stiffening;
   return m;
@@ -130,6 +138,7 @@ inline Monitors combined(const Monitors& a, const Monitors& b) {
                      : std::isnan(b.max_distortion) ? a.max_distortion
                                                     : std::max(a.max_distortion, b.max_distortion);
   m.near_edge = a.near_edge + b.near_edge;
+  m.folded_domains = a.folded_domains + b.folded_domains;
   m.max_wave_speed_ratio = std::max(a.max_wave_speed_ratio, b.max_wave_speed_ratio);
   m.max_basis_stiffening = std::max(a.max_basis_stiffening, b.max_basis_stiffening);
   return m;

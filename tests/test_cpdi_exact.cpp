@@ -17,6 +17,8 @@
 #include <vector>
 
 #include "solver/domain_corners.hpp"
+#include "solver/material/neo_hookean.hpp"
+#include "solver/monitors.hpp"
 #include "solver/particles.hpp"
 #include "solver/shape/cpdi.hpp"
 #include "solver/shape/cpdi_exact.hpp"
@@ -295,11 +297,16 @@ TEST(CpdiExactShape, CornerDomainIntegratesItsQuadrilateral) {
 }
 
 // A bow tie (corners 2 and 3 swapped past each other, positive signed area
-// left) integrates as the parallelogram a_0 +- a_1 +- a_2 of its linear part;
-// a quadrilateral turned over (clockwise) is folded and not inside.
-TEST(CpdiExactShape, CrossedCornerDomainTakesItsParallelogramAndATurnedOneStops) {
+// left) integrates as the parallelogram a_0 +- a_1 +- a_2 of its linear part.
+// A quadrilateral turned over (clockwise) is folded: its particle integrates
+// over its own parallelogram x_p + F_p A_p, as the parallelogram form does,
+// stays inside, and the monitors count it.
+TEST(CpdiExactShape, CrossedCornerDomainTakesItsParallelogramAndATurnedOneItsParticles) {
   const GridGeometry grid = grid_of(0.25);
-  const Particles P = one_particle(grid.origin + Vec2(1.37, 1.52), Mat2::Identity(), Vec2(0.08, 0.08));
+  Mat2 F;
+  F << 1.1, 0.6, -0.2, 0.9;
+  Particles P = one_particle(grid.origin + Vec2(1.37, 1.52), F, Vec2(0.08, 0.06));
+  P.mass[0] = 1.0;
   const Vec2 x = P.position[0];
   const std::vector<Vec2> bow = {x + Vec2(-0.1, -0.04), x + Vec2(0.12, -0.04), x + Vec2(-0.02, 0.04),
                                  x + Vec2(0.06, 0.02)};
@@ -311,15 +318,27 @@ TEST(CpdiExactShape, CrossedCornerDomainTakesItsParallelogramAndATurnedOneStops)
   for (int c = 0; c < 4; ++c) parallelogram.push_back(a0 + mpmvv::kCornerXi[c] * s.col(0) + mpmvv::kCornerEta[c] * s.col(1));
   expect_same_stencil(stencil_of<CornerExactShape>(grid, with_corners(P, bow)),
                       stencil_of<CornerExactShape>(grid, with_corners(P, parallelogram)), grid.h);
+  const mpmvv::NeoHookean material{577.0, 385.0};
   const Particles bowed = with_corners(P, bow);
   const CornerExactShape crossed = CornerExactShape::bind(grid, bowed);
   EXPECT_FALSE(crossed.folded(0));
   EXPECT_TRUE(crossed.inside(0));
+  EXPECT_EQ(mpmvv::monitor_particles(crossed, material, bowed, grid).folded_domains, 0u);
+
   const std::vector<Vec2> turned = {parallelogram[0], parallelogram[3], parallelogram[2], parallelogram[1]};
   const Particles turned_over = with_corners(P, turned);
   const CornerExactShape over = CornerExactShape::bind(grid, turned_over);
   EXPECT_TRUE(over.folded(0));
-  EXPECT_FALSE(over.inside(0));
+  EXPECT_TRUE(over.inside(0));
+  const Mat2 own = F * Vec2(0.08, 0.06).asDiagonal();
+  EXPECT_TRUE(over.domain(0).isApprox(own, 1e-15)) << over.domain(0);
+  expect_same_stencil(stencil_of<CornerExactShape>(grid, turned_over), stencil_of<CpdiExactShape>(grid, P), grid.h);
+  EXPECT_EQ(mpmvv::monitor_particles(over, material, turned_over, grid).folded_domains, 1u);
+  // The corner interpolation keeps the turned quadrilateral and is counted alike.
+  using CornerShape = mpmvv::CpdiShapeT<mpmvv::Geometry::plane_strain, mpmvv::CpdiForm::corners>;
+  EXPECT_EQ(mpmvv::monitor_particles(CornerShape::bind(grid, turned_over), material, turned_over, grid).folded_domains,
+            1u);
+  EXPECT_EQ(mpmvv::monitor_particles(CornerShape::bind(grid, bowed), material, bowed, grid).folded_domains, 0u);
 }
 
 }  // namespace

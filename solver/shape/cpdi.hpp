@@ -258,6 +258,14 @@ struct CpdiShapeT {
     st.count = n;
   }
 
+  // A corner domain turned over, 4 det [a_1 a_2] <= 0 (monitors.hpp:
+  // folded_domains). The factors above stay those of the signed integral over
+  // the quadrilateral as it stands, finite while det [a_1 a_2] is not zero.
+  bool folded(std::size_t p) const {
+    if constexpr (Corners) return !(determinant(corner_half_vectors(corners + 4 * p)) > 0.0);
+    return false;
+  }
+
   // The centre lies between the walls (in r-z off the axis) and every corner
   // of the domain in the grid (ghost layers included).
   bool inside(std::size_t p) const {

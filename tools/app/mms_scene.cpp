@@ -311,7 +311,7 @@ class MmsCase final : public SceneCase, private RunObserver {
                     "energy made from nothing (kinetic + strain - initial - work), the angular momentum about the origin and the "
                     "exact motion's over the same particles [kg m^2/s per unit depth; NaN in r-z], J's range, the largest particle "
                     "speed over its wave speed, the largest CPDI domain distortion (1: square), particles at the "
-                    "grid's edge, and what lifts the signal speed of the CFL step above the small-strain wave speed: "
+                    "grid's edge, CPDI corner domains turned over, and what lifts the signal speed of the CFL step above the small-strain wave speed: "
                     "the particle's state and density (max c_p / c0, c0 at the reference density) and the basis (max k_p) [J per unit depth; per radian in r-z]");
     g.set_attribute("initial_energy", initial_energy_);
     const std::size_t n = monitor_rows_.size();
@@ -335,6 +335,7 @@ class MmsCase final : public SceneCase, private RunObserver {
     column("max_speed_over_wave_speed", [](const MonitorRow& r) { return r.monitors.max_mach; });
     column("max_domain_distortion", [](const MonitorRow& r) { return r.monitors.max_distortion; });
     column("particles_near_edge", [](const MonitorRow& r) { return double(r.monitors.near_edge); });
+    column("folded_domains", [](const MonitorRow& r) { return double(r.monitors.folded_domains); });
     column("max_wave_speed_ratio", [](const MonitorRow& r) { return r.monitors.max_wave_speed_ratio; });
     column("max_basis_stiffening", [](const MonitorRow& r) { return r.monitors.max_basis_stiffening; });
     if (config_.integer("stable_step_iterations") > 0) {
