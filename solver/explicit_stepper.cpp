@@ -19,6 +19,7 @@
 #include "shape/bspline.hpp"
 #include "shape/gimp.hpp"
 #include "shape/linear.hpp"
+#include "shape/stored_stencils.hpp"
 #include "shape/total_lagrangian.hpp"
 #include "monitors.hpp"
 
@@ -260,11 +261,21 @@ class ExplicitStepper final : public Stepper {
     }
     Particles& P = model_.particles;
     const Shape shape = bind(P);
-    map_mass_momentum_and_forces(shape, t);
+    if constexpr (kStoresStencils<Shape>) {
+      // The map and the update weigh the same particles (stored_stencils.hpp).
+      stencils_.resize(P.size());
+      map_mass_momentum_and_forces(StencilRecorder<Shape>{shape, stencils_.data()}, t);
+    } else {
+      map_mass_momentum_and_forces(shape, t);
+    }
     advance_grid(shape, t, dt, kick);
     move_tracers(dt);
     remember_volumes();
-    velocities_from_grid<kVelocity | kPosition | kDeformation>(shape, fields_, dt, kick);
+    if constexpr (kStoresStencils<Shape>)
+      velocities_from_grid<kVelocity | kPosition | kDeformation>(StencilReader<Shape>{shape, stencils_.data()},
+                                                                 fields_, dt, kick);
+    else
+      velocities_from_grid<kVelocity | kPosition | kDeformation>(shape, fields_, dt, kick);
     move_domain_corners(dt);
     update_stress_of_particles(dt);
     book_body_work(dt);
@@ -379,7 +390,8 @@ class ExplicitStepper final : public Stepper {
     return Shape::bind(model_.grid, P, domain_deformation, gradient_scale_);
   }
 
-  void map_mass_momentum_and_forces(const Shape& shape, double t) {
+  template <class S>
+  void map_mass_momentum_and_forces(const S& shape, double t) {
     if (body_force_) {
       evaluate_body_force(t);
       momentum_to_grid<kMass | kMomentum | kInternalForce | kBodyForce>(shape, fields_);
@@ -391,20 +403,20 @@ class ExplicitStepper final : public Stepper {
   // The velocity transfer is chosen here, once per stage: under APIC every
   // map of momentum carries the particles' affine fields, and every velocity
   // update takes the grid's velocity and its gradient (model.hpp).
-  template <unsigned Fields>
-  void momentum_to_grid(const Shape& shape, GridFields& g, ParticleRange range = {}) {
+  template <unsigned Fields, class S>
+  void momentum_to_grid(const S& shape, GridFields& g, ParticleRange range = {}) {
     if (apic_)
       particles_to_grid<Fields | kAffineMomentum>(shape, model_.particles, buffers_, g, range, &model_.grid);
     else
       particles_to_grid<Fields>(shape, model_.particles, buffers_, g, range);
   }
-  template <unsigned Updates>
-  void velocities_from_grid(const Shape& shape, const GridFields& g, double dt, double kick,
+  template <unsigned Updates, class S>
+  void velocities_from_grid(const S& shape, const GridFields& g, double dt, double kick,
                             Vec2* position_out = nullptr, ParticleRange range = {}) {
     if (apic_)
-      grid_to_particles<Updates | kAffine, Shape>(shape, g, model_.particles, dt, kick, position_out, range);
+      grid_to_particles<Updates | kAffine, S>(shape, g, model_.particles, dt, kick, position_out, range);
     else
-      grid_to_particles<Updates, Shape>(shape, g, model_.particles, dt, kick, position_out, range);
+      grid_to_particles<Updates, S>(shape, g, model_.particles, dt, kick, position_out, range);
   }
 
   // The constitutive update, after the locking remedy when the run has it,
@@ -516,6 +528,8 @@ class ExplicitStepper final : public Stepper {
     if constexpr (requires { Shape::corner_domains; }) return Shape::corner_domains;
     return false;
   }();
+  // USL: each particle's stencil from the map, read back by the update (stored_stencils.hpp)
+  std::vector<Stencil<Shape::stencil_size>> stencils_;
   double viscosity_linear_, viscosity_quadratic_;  // bulk viscosity C0, C1 (add_bulk_viscosity); 0: none
   double viscous_ratio_ = 0.0;                     // its damping ratio in the last step
   std::vector<double> volume_before_;              // with bulk viscosity: V_p before the deformation update

@@ -20,6 +20,9 @@
 #include "solver/material/neo_hookean.hpp"
 #include "solver/monitors.hpp"
 #include "solver/particles.hpp"
+#include "solver/parallel.hpp"
+#include "solver/shape/stored_stencils.hpp"
+#include "solver/stages.hpp"
 #include "solver/shape/cpdi.hpp"
 #include "solver/shape/cpdi_exact.hpp"
 
@@ -339,6 +342,63 @@ TEST(CpdiExactShape, CrossedCornerDomainTakesItsParallelogramAndATurnedOneItsPar
   EXPECT_EQ(mpmvv::monitor_particles(CornerShape::bind(grid, turned_over), material, turned_over, grid).folded_domains,
             1u);
   EXPECT_EQ(mpmvv::monitor_particles(CornerShape::bind(grid, bowed), material, bowed, grid).folded_domains, 0u);
+}
+
+// USL's stored stencils (stored_stencils.hpp): a map through the recorder
+// gives the grid what the shape itself gives and keeps every particle's
+// stencil; an update through the reader then moves, deforms and turns the
+// particles exactly as one through the shape does. Sheared corner domains
+// across cell lines, under APIC, with a random grid velocity.
+TEST(StoredStencils, RecordedMapAndReadUpdateAreTheShapesOwn) {
+  const GridGeometry grid = grid_of(0.25);
+  Mat2 F;
+  F << 1.2, 0.7, -0.1, 0.9;
+  Particles P;
+  const int n = 12;
+  P.resize(n);
+  P.half_size.assign(n, Vec2(0.06, 0.05));
+  P.affine_velocity.assign(n, Mat2::Zero());
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int p = 0; p < n; ++p) {
+    P.position[p] = P.reference_position[p] = grid.origin + Vec2(1.1 + 0.13 * p, 1.3 + 0.07 * p);
+    P.deformation_gradient[p] = F;
+    P.reference_volume[p] = 4.0 * 0.06 * 0.05;
+    P.volume[p] = mpmvv::determinant(F) * P.reference_volume[p];
+    P.mass[p] = 1.0 + 0.1 * p;
+    P.velocity[p] = Vec2(u(random), u(random));
+    P.affine_velocity[p] << u(random), u(random), u(random), u(random);
+    P.stress[p] << 10.0 * u(random), u(random), u(random), 10.0 * u(random);
+  }
+  mpmvv::start_domain_corners(P);
+  const CornerExactShape shape = CornerExactShape::bind(grid, P);
+  std::vector<mpmvv::Stencil<CornerExactShape::stencil_size>> store(P.size());
+  const std::size_t nodes = grid.node_count();
+  mpmvv::ScatterBuffers buffers;
+  buffers.resize(mpmvv::max_threads(), nodes);
+  constexpr unsigned kMap = mpmvv::kMass | mpmvv::kMomentum | mpmvv::kInternalForce | mpmvv::kAffineMomentum;
+  mpmvv::GridFields direct, recorded;
+  direct.resize(nodes);
+  recorded.resize(nodes);
+  mpmvv::particles_to_grid<kMap>(shape, P, buffers, direct, {}, &grid);
+  mpmvv::particles_to_grid<kMap>(mpmvv::StencilRecorder<CornerExactShape>{shape, store.data()}, P, buffers, recorded,
+                                 {}, &grid);
+  EXPECT_EQ(direct.mass, recorded.mass);
+  EXPECT_EQ(direct.momentum, recorded.momentum);
+  EXPECT_EQ(direct.force, recorded.force);
+  for (std::size_t p = 0; p < P.size(); ++p) expect_same_stencil(by_node(store[p]), stencil_of<CornerExactShape>(grid, P, p), grid.h);
+
+  for (std::size_t k = 0; k < nodes; ++k) direct.velocity[k] = direct.acceleration[k] = Vec2(u(random), u(random));
+  constexpr unsigned kUpdate = mpmvv::kVelocity | mpmvv::kPosition | mpmvv::kDeformation | mpmvv::kAffine;
+  Particles by_shape = P, by_store = P;
+  mpmvv::grid_to_particles<kUpdate>(shape, direct, by_shape, 0.01, 0.01);
+  mpmvv::grid_to_particles<kUpdate>(mpmvv::StencilReader<CornerExactShape>{shape, store.data()}, direct, by_store,
+                                    0.01, 0.01);
+  EXPECT_EQ(by_shape.position, by_store.position);
+  EXPECT_EQ(by_shape.velocity, by_store.velocity);
+  EXPECT_EQ(by_shape.deformation_gradient, by_store.deformation_gradient);
+  EXPECT_EQ(by_shape.affine_velocity, by_store.affine_velocity);
+  EXPECT_NE(by_shape.position, P.position);  // the update moved them
 }
 
 }  // namespace

@@ -120,6 +120,9 @@ struct CpdiExactShapeT {
   static constexpr bool has_domain = true;
   static constexpr bool corner_domains = Corners;  // the stepper moves the corners (domain_corners.hpp)
   using GridBasis = LinearShapeT<G>;  // the domain averages the hats
+  // Clipping costs as much as the rest of a step: USL evaluates it once
+  // (stored_stencils.hpp).
+  static constexpr bool stores_stencils = true;
 
   const GridGeometry* grid;
   const Vec2* position;
