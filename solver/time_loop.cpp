@@ -33,6 +33,12 @@ const char* to_string(TimeStepRule r) {
   return "?";
 }
 
+std::atomic<bool>& stop_request() {
+  static std::atomic<bool> requested{false};
+  static_assert(std::atomic<bool>::is_always_lock_free, "set from a signal handler");
+  return requested;
+}
+
 RunOutcome run_time_loop(Stepper& stepper, const TimeLoopOptions& options, RunObserver& observer,
                          const ProgressSink& progress, double progress_interval_seconds) {
   if (options.output_times.empty() || options.output_times.back() != options.end_time)
@@ -91,6 +97,13 @@ RunOutcome run_time_loop(Stepper& stepper, const TimeLoopOptions& options, RunOb
   };
 
   while (out.failure_reason.empty() && next_output < options.output_times.size()) {
+    if (stop_request().load(std::memory_order_relaxed)) {
+      out.failure_reason = "interrupted";
+      out.failure_detail = "stopped on request (a signal) before step " + std::to_string(out.steps + 1);
+      out.failure_time = t;
+      out.failure_step = out.steps;
+      break;
+    }
     const bool due = out.steps == 0 || out.steps - steps_at_measurement >= options.track_every ||
                      scan.max_signal_speed > options.track_growth * signal_at_measurement;
     if (stable_rule && due && !measure()) {

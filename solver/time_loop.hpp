@@ -3,6 +3,7 @@
 // status, the reason, the time, the step and the particle.
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <functional>
 #include <limits>
@@ -111,6 +112,13 @@ struct Progress {
   bool final;
 };
 using ProgressSink = std::function<void(const Progress&)>;
+
+// A request to end the run before its next step, with what it has: the
+// failure reason "interrupted" (RunOutcome), so that whatever reads the
+// results knows them to be incomplete. Process-wide, because signals are:
+// `mpmvv run` sets it from its SIGINT and SIGTERM handlers (a lock-free atomic
+// store is safe there).
+std::atomic<bool>& stop_request();
 
 RunOutcome run_time_loop(Stepper& stepper, const TimeLoopOptions& options, RunObserver& observer,
                          const ProgressSink& progress = {}, double progress_interval_seconds = 1.0);

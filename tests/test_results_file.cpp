@@ -158,3 +158,31 @@ TEST(ResultsFile, FailedRunRecordsWhyWhenAndWhere) {
   ASSERT_FALSE(reached.empty());
   EXPECT_EQ(root.open_group("errors").read_doubles("time"), reached);
 }
+
+// A run stopped by SIGTERM before its end time writes what it computed, marked
+// "interrupted", and exits 130: the errors at the output times it reached,
+// nothing after them. `timeout` sends the signal after 5 s to a run that
+// needs about 20 s (the ring on 256 cells to t = 1 s, one thread).
+TEST(ResultsFile, RunStoppedBySignalWritesWhatItHasAsInterrupted) {
+  const fs::path out = scratch("interrupted.h5");
+  const std::string command = "timeout --preserve-status -s TERM 5 " + std::string(MPMVV_BINARY) + " run " +
+                              MPMVV_SOURCE_DIR + "/suites/scenes/ring.toml -q -t 1 --set cells=256 --set end_time=1 " +
+                              "--set output_times=[0.01,0.02,0.9] -o " + out.string() + " > /dev/null 2>&1";
+  const int status = std::system(command.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  ASSERT_TRUE(fs::exists(out));
+  EXPECT_FALSE(fs::exists(out.string() + ".partial"));
+  const mpmvv::h5::File file = mpmvv::h5::File::open_read(out.string());
+  const mpmvv::h5::Group root = file.root();
+  EXPECT_EQ(root.attribute_string("status"), "interrupted");
+  EXPECT_EQ(root.attribute_string("failure_reason"), "interrupted");
+  EXPECT_GT(root.attribute_int("steps"), 0);
+  const double reached = root.attribute_double("time_reached");
+  EXPECT_GT(reached, 0.0);
+  EXPECT_LT(reached, 0.9);
+  EXPECT_DOUBLE_EQ(root.attribute_double("failure_time"), reached);
+  std::vector<hsize_t> dims;
+  const std::vector<double> times = root.open_group("errors").read_doubles("time", &dims);
+  for (double t : times) EXPECT_LE(t, reached);
+}

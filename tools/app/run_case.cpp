@@ -1,5 +1,6 @@
 #include "run_case.hpp"
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -22,6 +23,7 @@
 #include "fault.hpp"
 #include "scene.hpp"
 #include "solver/parallel.hpp"
+#include "solver/time_loop.hpp"
 
 namespace mpmvv::app {
 
@@ -106,7 +108,9 @@ void write_results_file(const std::string& path, const RunRequest& request, cons
   root.set_attribute("version", version_string());
   if (fault != Fault::none) root.set_attribute("fault_injected", to_string(fault));
   root.set_attribute("threads", std::int64_t(max_threads()));
-  root.set_attribute("status", o.completed ? "completed" : "failed");
+  root.set_attribute("status", o.completed                            ? "completed"
+                               : o.failure_reason == "interrupted" ? "interrupted"
+                                                                   : "failed");
   root.set_attribute("failure_reason", o.failure_reason);
   root.set_attribute("failure_detail", o.failure_detail);
   root.set_attribute("failure_time", o.failure_time);
@@ -210,6 +214,22 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
   if (!request.quiet)
     fmt::print(err, "mpmvv run {} -> {} ({} threads)\nconfiguration:{}\n", request.scene_file, output, max_threads(),
                compact(config));
+  // SIGINT and SIGTERM end the run at its next step, and what it computed is
+  // written, marked "interrupted" (a second signal kills as usual).
+  struct sigaction action {};
+  action.sa_handler = [](int) { stop_request().store(true, std::memory_order_relaxed); };
+  action.sa_flags = SA_RESETHAND;
+  sigemptyset(&action.sa_mask);
+  struct sigaction before_int {}, before_term {};
+  sigaction(SIGINT, &action, &before_int);
+  sigaction(SIGTERM, &action, &before_term);
+  struct Restore {
+    struct sigaction interrupt, terminate;
+    ~Restore() {
+      sigaction(SIGINT, &interrupt, nullptr);
+      sigaction(SIGTERM, &terminate, nullptr);
+    }
+  } restore{before_int, before_term};
   RunOutcome o;
   try {
     o = scene->run(request.quiet ? ProgressSink{} : progress_printer(err));
@@ -240,6 +260,9 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
     fmt::print(out, "{} {}: completed t = {:.4g} s in {} steps, {:.3g} s wall ({:.3g} s forcing), {} particles, h = {:.4g} m, {:.3g} particle-steps/s\n",
                config.scene(), config.text("method"), o.time_reached, o.steps, o.wall_seconds, o.forcing_seconds,
                scene->particle_count(), scene->cell_size(), rate);
+  else if (o.failure_reason == "interrupted")
+    fmt::print(out, "{} {}: INTERRUPTED at t = {:.4g} s, step {}: what it computed is written (status \"interrupted\")\n",
+               config.scene(), config.text("method"), o.failure_time, o.failure_step);
   else
     fmt::print(out, "{} {}: FAILED at t = {:.4g} s, step {}{}: {} ({})\n", config.scene(), config.text("method"),
                o.failure_time, o.failure_step,
@@ -248,6 +271,7 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
   print_error_table(out, scene->errors());
   print_measurements(out, scene->measurements());
   fmt::print(out, "results: {}\n", output);
+  if (o.failure_reason == "interrupted") return 130;
   return o.completed ? 0 : 1;
 }
 

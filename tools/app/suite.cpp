@@ -652,6 +652,7 @@ std::optional<CaseState> finished_state(const fs::path& results, const SuiteCase
       return std::nullopt;
     CaseState s;
     s.status = root.attribute_string("status");
+    if (s.status == "interrupted") return std::nullopt;  // stopped by a signal before its end: run it again
     s.exit_code = s.status == "completed" ? 0 : 1;
     s.wall = root.attribute_double("wall_time_s");
     if (s.status != "completed")
