@@ -44,6 +44,11 @@ inline Mat2 corner_half_vectors(const Vec2* x) {
   return s;
 }
 
+// A quadrilateral turned over: the signed area of its linear part, 4 det
+// [a_1 a_2], is not positive (NaN corners count as turned). Its corners no
+// longer bound the material (cpdi.hpp, cpdi_exact.hpp: folded).
+inline bool turned_over(const Mat2& half_vectors) { return !(determinant(half_vectors) > 0.0); }
+
 // The corners of each particle's parallelogram x_p + F_p A_p (xi, eta), the
 // domain it starts from. Neighbouring seeded domains meet edge to edge, so
 // their corners coincide (to the round-off of x_p +- l_p).

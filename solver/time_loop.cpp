@@ -98,7 +98,7 @@ RunOutcome run_time_loop(Stepper& stepper, const TimeLoopOptions& options, RunOb
 
   while (out.failure_reason.empty() && next_output < options.output_times.size()) {
     if (stop_request().load(std::memory_order_relaxed)) {
-      out.failure_reason = "interrupted";
+      out.failure_reason = kInterrupted;
       out.failure_detail = "stopped on request (a signal) before step " + std::to_string(out.steps + 1);
       out.failure_time = t;
       out.failure_step = out.steps;

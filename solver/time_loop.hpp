@@ -119,6 +119,7 @@ using ProgressSink = std::function<void(const Progress&)>;
 // `mpmvv run` sets it from its SIGINT and SIGTERM handlers (a lock-free atomic
 // store is safe there).
 std::atomic<bool>& stop_request();
+inline constexpr const char* kInterrupted = "interrupted";  // the failure reason and status of such a run
 
 RunOutcome run_time_loop(Stepper& stepper, const TimeLoopOptions& options, RunObserver& observer,
                          const ProgressSink& progress = {}, double progress_interval_seconds = 1.0);

@@ -262,7 +262,7 @@ struct CpdiShapeT {
   // folded_domains). The factors above stay those of the signed integral over
   // the quadrilateral as it stands, finite while det [a_1 a_2] is not zero.
   bool folded(std::size_t p) const {
-    if constexpr (Corners) return !(determinant(corner_half_vectors(corners + 4 * p)) > 0.0);
+    if constexpr (Corners) return turned_over(corner_half_vectors(corners + 4 * p));
     return false;
   }
 

@@ -157,7 +157,7 @@ struct CpdiExactShapeT {
   Mat2 domain(std::size_t p) const {
     if constexpr (Corners) {
       const Mat2 s = corner_half_vectors(corners + 4 * p);
-      if (determinant(s) > 0.0) return s;
+      if (!turned_over(s)) return s;
     }
     Mat2 s = domain_map(p);
     s.col(0) *= half_size[p].x();
@@ -330,7 +330,7 @@ struct CpdiExactShapeT {
   // rim, where the corner interpolation of cpdi.hpp turns the same 4 over).
   // Monitors::folded_domains counts them at every output.
   bool folded(std::size_t p) const {
-    if constexpr (Corners) return !(determinant(corner_half_vectors(corners + 4 * p)) > 0.0);
+    if constexpr (Corners) return turned_over(corner_half_vectors(corners + 4 * p));
     return false;
   }
 

@@ -109,7 +109,7 @@ void write_results_file(const std::string& path, const RunRequest& request, cons
   if (fault != Fault::none) root.set_attribute("fault_injected", to_string(fault));
   root.set_attribute("threads", std::int64_t(max_threads()));
   root.set_attribute("status", o.completed                            ? "completed"
-                               : o.failure_reason == "interrupted" ? "interrupted"
+                               : o.failure_reason == kInterrupted ? kInterrupted
                                                                    : "failed");
   root.set_attribute("failure_reason", o.failure_reason);
   root.set_attribute("failure_detail", o.failure_detail);
@@ -260,7 +260,7 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
     fmt::print(out, "{} {}: completed t = {:.4g} s in {} steps, {:.3g} s wall ({:.3g} s forcing), {} particles, h = {:.4g} m, {:.3g} particle-steps/s\n",
                config.scene(), config.text("method"), o.time_reached, o.steps, o.wall_seconds, o.forcing_seconds,
                scene->particle_count(), scene->cell_size(), rate);
-  else if (o.failure_reason == "interrupted")
+  else if (o.failure_reason == kInterrupted)
     fmt::print(out, "{} {}: INTERRUPTED at t = {:.4g} s, step {}: what it computed is written (status \"interrupted\")\n",
                config.scene(), config.text("method"), o.failure_time, o.failure_step);
   else
@@ -271,7 +271,7 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
   print_error_table(out, scene->errors());
   print_measurements(out, scene->measurements());
   fmt::print(out, "results: {}\n", output);
-  if (o.failure_reason == "interrupted") return 130;
+  if (o.failure_reason == kInterrupted) return 130;
   return o.completed ? 0 : 1;
 }
 

@@ -32,6 +32,7 @@
 #include "config.hpp"
 #include "scene.hpp"
 #include "solver/io/hdf5.hpp"
+#include "solver/time_loop.hpp"
 
 extern char** environ;
 
@@ -652,7 +653,7 @@ std::optional<CaseState> finished_state(const fs::path& results, const SuiteCase
       return std::nullopt;
     CaseState s;
     s.status = root.attribute_string("status");
-    if (s.status == "interrupted") return std::nullopt;  // stopped by a signal before its end: run it again
+    if (s.status == kInterrupted) return std::nullopt;  // stopped by a signal before its end: run it again
     s.exit_code = s.status == "completed" ? 0 : 1;
     s.wall = root.attribute_double("wall_time_s");
     if (s.status != "completed")
