@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdint>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <optional>
 #include <stdexcept>
@@ -136,6 +137,22 @@ class ExplicitStepper final : public Stepper {
     return s;
   }
 
+  // USL and MUSL of one body of one material map mass, momentum and forces
+  // first, with no dt: that map scans too (stages.hpp: ScanInMap), and the
+  // scan evaluates no stencil of its own.
+  ParticleScan prepare_step(double t) override {
+    const bool maps_first = scheme_ != Scheme::usf && second_ == 0 && !second_material_;
+    if (!maps_first) return scan();
+    const Shape shape = bind(model_.particles);
+    ScanInMap<Shape, Material> scanning{shape, material_, model_.particles, model_.grid.h};
+    map_step(t, &scanning);
+    ParticleScan s = scanning.result;
+    // An unhealthy particle was left out of the map: the run stops here.
+    if (s.first_unhealthy == model_.particles.size()) mapped_at_ = t;
+    if (viscous()) s.max_signal_speed *= std::sqrt(1.0 + viscous_ratio_ * viscous_ratio_) + viscous_ratio_;
+    return s;
+  }
+
   Monitors monitors() const override {
     const Shape shape = bind(model_.particles);
     Monitors m;
@@ -259,15 +276,8 @@ class ExplicitStepper final : public Stepper {
       step_usl_two_bodies(t, dt, kick);
       return;
     }
-    Particles& P = model_.particles;
-    const Shape shape = bind(P);
-    if constexpr (kStoresStencils<Shape>) {
-      // The map and the update weigh the same particles (stored_stencils.hpp).
-      stencils_.resize(P.size());
-      map_mass_momentum_and_forces(StencilRecorder<Shape>{shape, stencils_.data()}, t);
-    } else {
-      map_mass_momentum_and_forces(shape, t);
-    }
+    const Shape shape = bind(model_.particles);
+    map_unless_prepared(t);
     advance_grid(shape, t, dt, kick);
     move_tracers(dt);
     remember_volumes();
@@ -368,7 +378,7 @@ class ExplicitStepper final : public Stepper {
   void step_musl(double t, double dt, double kick) {
     Particles& P = model_.particles;
     const Shape shape = bind(P);
-    map_mass_momentum_and_forces(shape, t);
+    map_unless_prepared(t);
     advance_grid(shape, t, dt, kick);
     move_tracers(dt);
     velocities_from_grid<kVelocity | kPosition>(shape, fields_, dt, kick, next_position_.data());
@@ -390,25 +400,49 @@ class ExplicitStepper final : public Stepper {
     return Shape::bind(model_.grid, P, domain_deformation, gradient_scale_);
   }
 
-  template <class S>
-  void map_mass_momentum_and_forces(const S& shape, double t) {
+  // The first stage of USL and MUSL: mass, momentum and forces at t mapped to
+  // the grid, with the scan of the state it weighs when `scan` is given
+  // (prepare_step). Under USL a shape that stores its stencils records them
+  // here for the update (stored_stencils.hpp).
+  template <class Scan = NoScan>
+  void map_step(double t, Scan* scan = nullptr) {
+    const Shape shape = bind(model_.particles);
+    if constexpr (kStoresStencils<Shape>) {
+      if (scheme_ == Scheme::usl) {
+        stencils_.resize(model_.particles.size());
+        map_mass_momentum_and_forces(StencilRecorder<Shape>{shape, stencils_.data()}, t, scan);
+        return;
+      }
+    }
+    map_mass_momentum_and_forces(shape, t, scan);
+  }
+
+  // The map, unless prepare_step made it for this step.
+  void map_unless_prepared(double t) {
+    const bool prepared = mapped_at_ == t;
+    mapped_at_ = kNotMapped;
+    if (!prepared) map_step(t);
+  }
+
+  template <class S, class Scan = NoScan>
+  void map_mass_momentum_and_forces(const S& shape, double t, Scan* scan = nullptr) {
     if (body_force_) {
       evaluate_body_force(t);
-      momentum_to_grid<kMass | kMomentum | kInternalForce | kBodyForce>(shape, fields_);
+      momentum_to_grid<kMass | kMomentum | kInternalForce | kBodyForce>(shape, fields_, {}, scan);
     } else {
-      momentum_to_grid<kMass | kMomentum | kInternalForce>(shape, fields_);
+      momentum_to_grid<kMass | kMomentum | kInternalForce>(shape, fields_, {}, scan);
     }
   }
 
   // The velocity transfer is chosen here, once per stage: under APIC every
   // map of momentum carries the particles' affine fields, and every velocity
   // update takes the grid's velocity and its gradient (model.hpp).
-  template <unsigned Fields, class S>
-  void momentum_to_grid(const S& shape, GridFields& g, ParticleRange range = {}) {
+  template <unsigned Fields, class S, class Scan = NoScan>
+  void momentum_to_grid(const S& shape, GridFields& g, ParticleRange range = {}, Scan* scan = nullptr) {
     if (apic_)
-      particles_to_grid<Fields | kAffineMomentum>(shape, model_.particles, buffers_, g, range, &model_.grid);
+      particles_to_grid<Fields | kAffineMomentum>(shape, model_.particles, buffers_, g, range, &model_.grid, scan);
     else
-      particles_to_grid<Fields>(shape, model_.particles, buffers_, g, range);
+      particles_to_grid<Fields>(shape, model_.particles, buffers_, g, range, nullptr, scan);
   }
   template <unsigned Updates, class S>
   void velocities_from_grid(const S& shape, const GridFields& g, double dt, double kick,
@@ -528,6 +562,9 @@ class ExplicitStepper final : public Stepper {
     if constexpr (requires { Shape::corner_domains; }) return Shape::corner_domains;
     return false;
   }();
+  // The time of the step whose map prepare_step made, or kNotMapped.
+  static constexpr double kNotMapped = -std::numeric_limits<double>::infinity();
+  double mapped_at_ = kNotMapped;
   // USL: each particle's stencil from the map, read back by the update (stored_stencils.hpp)
   std::vector<Stencil<Shape::stencil_size>> stencils_;
   double viscosity_linear_, viscosity_quadratic_;  // bulk viscosity C0, C1 (add_bulk_viscosity); 0: none

@@ -32,6 +32,11 @@ class Stepper {
   virtual void step(double t, double dt, double kick) = 0;
   // Largest signal speed and the first particle whose state stops the run.
   virtual ParticleScan scan() const = 0;
+  // The same scan, made while the step that starts at t does its first stage,
+  // which weighs the same state (an explicit step's map: no stage of the
+  // step needs dt before it). The next step(t, ...) then starts after that
+  // stage. A stepper without such a stage only scans.
+  virtual ParticleScan prepare_step(double /*t*/) { return scan(); }
   virtual ParticleFault diagnose(std::size_t particle) const = 0;
 
   const Model& model() const { return model_; }

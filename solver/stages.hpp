@@ -63,12 +63,18 @@ struct ParticleRange {
   std::size_t end(const Particles& P) const { return std::min(last, P.size()); }
 };
 
+// A map without a scan (ScanInMap, below).
+struct NoScan {};
+
 // Sums the particle quantities selected by `Fields` onto the grid and stores
 // them in `g`, overwriting those node fields (the others are left as they are).
-// kAffineMomentum reads the node positions from `grid`.
-template <unsigned Fields, class Shape>
+// kAffineMomentum reads the node positions from `grid`. With `scan` (a
+// ScanInMap) the map also scans the state it weighs, into scan->result.
+template <unsigned Fields, class Shape, class Scan = NoScan>
 void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& buffers,
-                       GridFields& g, ParticleRange range = {}, const GridGeometry* grid = nullptr) {
+                       GridFields& g, ParticleRange range = {}, const GridGeometry* grid = nullptr,
+                       Scan* scan = nullptr) {
+  constexpr bool scanning = !std::is_same_v<Scan, NoScan>;
   constexpr bool with_mass = Fields & kMass;
   constexpr bool with_momentum = Fields & kMomentum;
   constexpr bool with_affine = Fields & kAffineMomentum;
@@ -86,9 +92,18 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
     NodeSums* sums = buffers.per_thread[std::size_t(thread_id())].data();
     std::fill(sums, sums + nodes, NodeSums{0.0, 0.0, 0.0, 0.0, 0.0});
     Stencil<Shape::stencil_size> s;
+    [[maybe_unused]] double max_speed = 0.0;
+    [[maybe_unused]] std::size_t first_unhealthy = P.size();
 #pragma omp for schedule(static)
     for (std::size_t p = range.first; p < n; ++p) {
+      if constexpr (scanning) {
+        if (!scan->healthy(p)) {
+          first_unhealthy = std::min(first_unhealthy, p);
+          continue;
+        }
+      }
       shape.evaluate(p, s);
+      if constexpr (scanning) max_speed = std::max(max_speed, scan->speed(p, s, max_speed));
       const double m = P.mass[p];
       Vec2 momentum = Vec2::Zero(), body = Vec2::Zero();
       Mat2 volume_stress = Mat2::Zero();
@@ -119,7 +134,15 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
         }
       }
     }
-    // The implicit barrier of `omp for` above: all buffers are complete.
+    if constexpr (scanning) {
+      // A largest and a lowest: the same whatever order the threads come in.
+#pragma omp critical
+      {
+        scan->result.max_signal_speed = std::max(scan->result.max_signal_speed, max_speed);
+        scan->result.first_unhealthy = std::min(scan->result.first_unhealthy, first_unhealthy);
+      }
+    }
+    // The implicit barrier of the particles' `omp for` above: all buffers are complete.
 #pragma omp for schedule(static)
     for (std::size_t i = 0; i < nodes; ++i) {
       NodeSums total = buffers.per_thread[0][i];
@@ -515,16 +538,14 @@ bool particle_healthy(const Shape& shape, const Particles& P, std::size_t p) {
   return finite && J > 0.0 && shape.inside(p);
 }
 
-// The sum over nodes of |G_gp| for particle p's stencil, each node counted
-// once: a full stencil may list a node more than once (a stretched CPDI
-// domain, once per corner that reaches it); one that is not full (cpdi.hpp)
-// lists each node once already.
-template <class Shape>
-double gradient_sum(const Shape& shape, std::size_t p) {
-  Stencil<Shape::stencil_size> s;
-  shape.evaluate(p, s);
+// The sum over nodes of |G_gp| of a stencil, each node counted once: a full
+// stencil may list a node more than once (a stretched CPDI domain, once per
+// corner that reaches it); one that is not full (cpdi.hpp) lists each node
+// once already.
+template <int N>
+double gradient_sum(const Stencil<N>& s) {
   double sum = 0.0;
-  if (s.count < Shape::stencil_size) {
+  if (s.count < N) {
     for (int k = 0; k < s.count; ++k) sum += s.gradient[k].norm();
     return sum;
   }
@@ -538,6 +559,14 @@ double gradient_sum(const Shape& shape, std::size_t p) {
     sum += g.norm();
   }
   return sum;
+}
+
+// The same for particle p's stencil, evaluated here.
+template <class Shape>
+double gradient_sum(const Shape& shape, std::size_t p) {
+  Stencil<Shape::stencil_size> s;
+  shape.evaluate(p, s);
+  return gradient_sum(s);
 }
 
 // How many times higher particle p lifts the grid's frequencies than the
@@ -563,8 +592,14 @@ double stiffening(const Shape& shape, std::size_t p, double h) {
   }
 }
 
-// One pass over particles: the largest signal speed max(c_p, k_p c0_p) + |v_p|
-// (c_p + |v_p| where k_p = 1) and the first particle whose state stops the run. c_p is the material's
+// The same from the particle's stencil, where the caller has it.
+template <int N>
+double stiffening(const Stencil<N>& s, double h) {
+  return std::max(1.0, h * gradient_sum(s) / kGridBasisGradientBound);
+}
+
+// The largest signal speed max(c_p, k_p c0_p) + |v_p| over particles (c_p +
+// |v_p| where k_p = 1) and the first particle whose state stops the run. c_p is the material's
 // wave speed bound at the particle's current state (it grows with the stress
 // along a stretched direction), c0_p the small-strain wave speed
 // sqrt((lambda + 2 mu) / rho_p), k_p the particle's stiffening (above), and
@@ -576,8 +611,47 @@ double stiffening(const Shape& shape, std::size_t p, double h) {
 // to 8.0, c_p / c0_p to about 4. Without k_p the step outgrows 2 / omega_max
 // as the ring comes to rest most twisted, and finer meshes, taking more steps
 // through that stretch, blow up first.
-// Over particles [begin, end) of one material; first_unhealthy is P.size()
-// when none of them stops the run.
+//
+// Particle p's term, given the largest so far: k_p needs the particle's
+// stencil, which is costly, and merging its repeated nodes, so it is formed
+// only where the particle could set a new largest speed (the bounds below are
+// exact-safe: the maximum is what forming every k_p gives). `stencil` is the
+// particle's stencil when the caller has evaluated it at the same state
+// (ScanInMap), else null.
+template <class Shape, class Material>
+double signal_speed(const Shape& shape, const Material& material, const Particles& P, double h, std::size_t p,
+                    double largest, const Stencil<Shape::stencil_size>* stencil = nullptr) {
+  const double density = P.mass[p] / P.volume[p];
+  const double F33 = out_of_plane_stretch<Shape::geometry>(P, p);
+  const double c = std::sqrt(material.wave_modulus(P.deformation_gradient[p], F33, P.stress[p]) / density);
+  const double v = P.velocity[p].norm();
+  double speed = c;
+  // The total Lagrangian formulation: a wave crosses the current image of a
+  // reference cell, F_p h along its most compressed direction.
+  if constexpr (requires { shape.cell_stretch(p); }) speed = c / std::min(1.0, shape.cell_stretch(p));
+  if constexpr (Shape::gradients_beyond_grid_basis) {
+    const double c_small = std::sqrt(material.p_wave_modulus() / density);
+    // With the stencil at hand the bound is its sum of |G| over entries, which
+    // is k_p's own sum where no node repeats (a stencil that is not full).
+    double bound = 0.0;
+    if (stencil) {
+      for (int k = 0; k < stencil->count; ++k) bound += stencil->gradient[k].norm();
+    } else {
+      bound = shape.gradient_sum_bound(p);
+    }
+    const double most = std::max(1.0, h * bound / kGridBasisGradientBound);
+    if (std::max(c, most * c_small) + v > largest) {
+      double k = most;
+      if (!stencil) k = stiffening(shape, p, h);
+      else if (stencil->count == Shape::stencil_size) k = stiffening(*stencil, h);
+      if (k > 1.0) speed = std::max(c, k * c_small);
+    }
+  }
+  return speed + v;
+}
+
+// One pass over particles [begin, end) of one material; first_unhealthy is
+// P.size() when none of them stops the run.
 template <class Shape, class Material>
 ParticleScan scan_particles(const Shape& shape, const Material& material, const Particles& P, double h,
                             std::size_t begin = 0, std::size_t end = kAllParticles) {
@@ -590,27 +664,29 @@ ParticleScan scan_particles(const Shape& shape, const Material& material, const 
       first = std::min(first, p);
       continue;
     }
-    const double density = P.mass[p] / P.volume[p];
-    const double F33 = out_of_plane_stretch<Shape::geometry>(P, p);
-    const double c = std::sqrt(material.wave_modulus(P.deformation_gradient[p], F33, P.stress[p]) / density);
-    const double v = P.velocity[p].norm();
-    double speed = c;
-    // The total Lagrangian formulation: a wave crosses the current image of a
-    // reference cell, F_p h along its most compressed direction.
-    if constexpr (requires { shape.cell_stretch(p); }) speed = c / std::min(1.0, shape.cell_stretch(p));
-    if constexpr (Shape::gradients_beyond_grid_basis) {
-      // The stencil only where the particle could set a new largest speed:
-      // the bound below is exact-safe, so the maximum is what evaluating
-      // every particle gives (and costs a third of a step less).
-      const double c_small = std::sqrt(material.p_wave_modulus() / density);
-      const double most = std::max(1.0, h * shape.gradient_sum_bound(p) / kGridBasisGradientBound);
-      if (std::max(c, most * c_small) + v > max_speed)
-        if (const double k = stiffening(shape, p, h); k > 1.0) speed = std::max(c, k * c_small);
-    }
-    max_speed = std::max(max_speed, speed + v);
+    max_speed = std::max(max_speed, signal_speed(shape, material, P, h, p, max_speed));
   }
   return {max_speed, first};
 }
+
+// The same scan made by the map of the step to come (particles_to_grid), which
+// weighs the state the scan reads and evaluates every particle's stencil
+// anyway: the map tests a particle's health before it evaluates the stencil
+// (an unhealthy particle's stencil may leave the grid) and skips one that
+// fails; then the speed reads the stencil the map has. One material.
+template <class Shape, class Material>
+struct ScanInMap {
+  const Shape& shape;
+  const Material& material;
+  const Particles& P;
+  double h;
+  ParticleScan result{0.0, P.size()};
+
+  bool healthy(std::size_t p) const { return particle_healthy(shape, P, p); }
+  double speed(std::size_t p, const Stencil<Shape::stencil_size>& s, double largest) const {
+    return signal_speed(shape, material, P, h, p, largest, &s);
+  }
+};
 
 // The scan of a run with two materials: the larger speed, the first particle.
 inline ParticleScan combined(const ParticleScan& a, const ParticleScan& b) {

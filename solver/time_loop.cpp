@@ -66,7 +66,7 @@ RunOutcome run_time_loop(Stepper& stepper, const TimeLoopOptions& options, RunOb
   double t = 0.0;
   double previous_dt = 0.0;
   std::size_t next_output = 0;
-  ParticleScan scan = stepper.scan();
+  ParticleScan scan = stepper.prepare_step(t);
   if (scan.first_unhealthy < n()) fail(scan, t);
 
   // TimeStepRule::stable: the last two measurements of omega_max, and the
@@ -167,7 +167,9 @@ RunOutcome run_time_loop(Stepper& stepper, const TimeLoopOptions& options, RunOb
     t = lands ? target : t + dt;
     observer.after_step(t, stepper);
 
-    scan = stepper.scan();
+    // After the last step only the health counts: no step is prepared.
+    const bool last = lands && next_output + 1 == options.output_times.size();
+    scan = last ? stepper.scan() : stepper.prepare_step(t);
     if (scan.first_unhealthy < n()) {
       fail(scan, t);
       break;

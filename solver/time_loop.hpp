@@ -30,7 +30,7 @@ const char* to_string(TimeIntegration t);
 
 // How long a step is.
 enum class TimeStepRule {
-  // dt = cfl h / max_p (c_p + |v_p|) (Stepper::scan, stages.hpp: scan_particles).
+  // dt = cfl h / max_p (c_p + |v_p|) (Stepper::prepare_step, stages.hpp: scan_particles).
   cfl,
   // dt = cfl 2 / omega_max: a fraction of the stable step of central
   // differences, omega_max measured by power iteration on the step's own
