@@ -127,6 +127,7 @@ class ExplicitStepper final : public Stepper {
   // last step, and central differences are stable to dt = (2 / omega)
   // (sqrt(1 + xi^2) - xi): the signal speed grows by sqrt(1 + xi^2) + xi.
   ParticleScan scan() const override {
+    const StageClock clock(stage_times_.scan);
     const Shape shape = bind(model_.particles);
     ParticleScan s;
     s.first_unhealthy = model_.particles.size();
@@ -151,6 +152,14 @@ class ExplicitStepper final : public Stepper {
     if (s.first_unhealthy == model_.particles.size()) mapped_at_ = t;
     if (viscous()) s.max_signal_speed *= std::sqrt(1.0 + viscous_ratio_ * viscous_ratio_) + viscous_ratio_;
     return s;
+  }
+
+  double bytes_per_particle() const override {
+    const std::size_t n = model_.particles.size();
+    auto of = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+    const std::size_t own = of(stencils_) + of(next_position_) + of(next_corner_) + of(step_start_deformation_) +
+                            of(volume_before_);
+    return n ? double(model_.particles.bytes() + own) / double(n) : 0.0;
   }
 
   Monitors monitors() const override {
@@ -296,6 +305,7 @@ class ExplicitStepper final : public Stepper {
   // still needed (MUSL), else in place.
   void move_domain_corners(double dt, std::vector<Vec2>* to = nullptr) {
     if constexpr (kCornerDomains) {
+      const StageClock clock(stage_times_.update);
       std::vector<Vec2>& corners = model_.particles.domain_corner;
       move_corners(model_.grid, fields_, corners, to ? *to : corners, dt);
     }
@@ -358,13 +368,18 @@ class ExplicitStepper final : public Stepper {
     if (!constraints_.empty()) apply_constraints(constraints_, t, dt, kick, fields_);
     if (rest_) rest_->apply(fields_, kick);
     remember_volumes();
-    grid_to_particles<kDeformation, Shape>(shape, fields_, P, dt, kick);
+    {
+      const StageClock clock(stage_times_.update);
+      grid_to_particles<kDeformation, Shape>(shape, fields_, P, dt, kick);
+    }
     update_stress_of_particles(dt);
-    if (body_force_) {
-      evaluate_body_force(t);
-      particles_to_grid<kInternalForce | kBodyForce>(shape, P, buffers_, fields_);
-    } else {
-      particles_to_grid<kInternalForce>(shape, P, buffers_, fields_);
+    if (body_force_) evaluate_body_force(t);
+    {
+      const StageClock clock(stage_times_.map);
+      if (body_force_)
+        particles_to_grid<kInternalForce | kBodyForce>(shape, P, buffers_, fields_);
+      else
+        particles_to_grid<kInternalForce>(shape, P, buffers_, fields_);
     }
     advance_grid(shape, t, dt, kick);
     move_tracers(dt);
@@ -389,7 +404,10 @@ class ExplicitStepper final : public Stepper {
     if (!constraints_.empty()) apply_constraints(constraints_, t, dt, kick, fields_);
     if (rest_) rest_->apply(fields_, kick);
     remember_volumes();
-    grid_to_particles<kDeformation, Shape>(shape, fields_, P, dt, kick);
+    {
+      const StageClock clock(stage_times_.update);
+      grid_to_particles<kDeformation, Shape>(shape, fields_, P, dt, kick);
+    }
     P.position.swap(next_position_);
     if constexpr (kCornerDomains) P.domain_corner.swap(next_corner_);
     update_stress_of_particles(dt);
@@ -439,6 +457,7 @@ class ExplicitStepper final : public Stepper {
   // update takes the grid's velocity and its gradient (model.hpp).
   template <unsigned Fields, class S, class Scan = NoScan>
   void momentum_to_grid(const S& shape, GridFields& g, ParticleRange range = {}, Scan* scan = nullptr) {
+    const StageClock clock(stage_times_.map);
     if (apic_)
       particles_to_grid<Fields | kAffineMomentum>(shape, model_.particles, buffers_, g, range, &model_.grid, scan);
     else
@@ -447,6 +466,7 @@ class ExplicitStepper final : public Stepper {
   template <unsigned Updates, class S>
   void velocities_from_grid(const S& shape, const GridFields& g, double dt, double kick,
                             Vec2* position_out = nullptr, ParticleRange range = {}) {
+    const StageClock clock(stage_times_.update);
     if (apic_)
       grid_to_particles<Updates | kAffine, S>(shape, g, model_.particles, dt, kick, position_out, range);
     else
@@ -456,6 +476,7 @@ class ExplicitStepper final : public Stepper {
   // The constitutive update, after the locking remedy when the run has it,
   // then the bulk viscosity of the step's dilatation when it has that.
   void update_stress_of_particles(double dt) {
+    const StageClock clock(stage_times_.stress);
     Particles& P = model_.particles;
     if (dilatation_ == Dilatation::cell_averaged) average_cell_dilatation<Shape::geometry>(model_.grid, P, volume_sums_);
     if (dilatation_ == Dilatation::node_smoothed)
@@ -497,6 +518,7 @@ class ExplicitStepper final : public Stepper {
   // contact. (The velocity-only passes of USF and MUSL see contact through
   // the particle velocities it has corrected.)
   void advance_grid(const Shape& shape, double t, double dt, double kick) {
+    const StageClock clock(stage_times_.grid);
     update_grid_motion(fields_, kick);
     if (damping_ > 0.0) damp_grid_motion(fields_, damping_, kick);
     apply_walls(model_.grid, fields_);
@@ -542,6 +564,7 @@ class ExplicitStepper final : public Stepper {
 
   void move_tracers(double dt) {
     if (model_.tracers.empty()) return;
+    const StageClock clock(stage_times_.update);
     if constexpr (requires { Shape::total_lagrangian; })
       advect_tracers(model_.grid, fields_, model_.tracers, dt, &tracer_reference_);
     else

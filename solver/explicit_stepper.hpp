@@ -13,6 +13,7 @@
 #include "boundary.hpp"
 #include "model.hpp"
 #include "monitors.hpp"
+#include "stage_times.hpp"
 
 namespace mpmvv {
 
@@ -44,6 +45,14 @@ class Stepper {
   const GridFields& grid_fields() const { return fields_; }
   // Wall time spent evaluating the body force, apart from the solver's own.
   double forcing_seconds() const { return forcing_seconds_; }
+  // Wall time per stage of the step so far (stage_times.hpp); zero for a
+  // stepper whose stages are not timed.
+  const StageTimes& stage_times() const { return stage_times_; }
+  // The bytes the particles' arrays and the stepper's own arrays per particle
+  // hold now, over the particle count.
+  virtual double bytes_per_particle() const {
+    return model_.particles.size() ? double(model_.particles.bytes()) / double(model_.particles.size()) : 0.0;
+  }
   // Per node constraint of the scene, its reaction in the last step
   // (apply_constraints); empty without constraints.
   const std::vector<double>& constraint_reactions() const { return reactions_; }
@@ -68,6 +77,7 @@ class Stepper {
   Model model_;
   GridFields fields_;
   double forcing_seconds_ = 0.0;
+  mutable StageTimes stage_times_;  // mutable: scan() is const
   std::vector<double> reactions_;
   ContactForces contact_forces_;
   EnergyLedger ledger_;

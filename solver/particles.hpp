@@ -63,6 +63,15 @@ struct Particles {
 
   std::size_t size() const { return position.size(); }
 
+  // The bytes the arrays hold (their capacity).
+  std::size_t bytes() const {
+    auto of = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+    return of(position) + of(velocity) + of(deformation_gradient) + of(volume) + of(stress) + of(mass) +
+           of(reference_volume) + of(reference_position) + of(half_size) + of(domain_axes) + of(domain_corner) +
+           of(domain_first) + of(domain_vertex) + of(hoop_stretch) + of(hoop_stress) + of(affine_velocity) +
+           of(body_force);
+  }
+
   // A_p: the columns span particle p's reference domain about X_p.
   Mat2 reference_domain(std::size_t p) const {
     if (!domain_axes.empty()) return domain_axes[p];

@@ -200,6 +200,8 @@ RunOutcome run_time_loop(Stepper& stepper, const TimeLoopOptions& options, RunOb
   out.completed = out.failure_reason.empty();
   out.wall_seconds = seconds_since(start);
   out.forcing_seconds = stepper.forcing_seconds();
+  out.stage_seconds = stepper.stage_times();
+  out.bytes_per_particle = stepper.bytes_per_particle();
   if (progress) {
     const double rate = out.wall_seconds > 0.0 ? double(out.particle_steps) / out.wall_seconds : 0.0;
     progress({out.steps, t, options.end_time, rate, 0.0, true});

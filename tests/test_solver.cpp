@@ -1215,6 +1215,22 @@ TEST(TimeLoop, AStepPreparedByItsMapScansAndMovesAsOneThatMapsItself) {
   }
 }
 
+// The memory a run holds per particle (Stepper::bytes_per_particle, the
+// throughput benchmark's bytes column): linear MPM's eight arrays, x, v, F,
+// V, sigma, m, V0 and X (16 + 16 + 32 + 8 + 32 + 8 + 8 + 16 = 136 bytes); GIMP
+// adds its half sizes (16); MUSL's stepper its next positions (16).
+TEST(Stepper, BytesPerParticleCountEveryArrayItHolds) {
+  auto linear = mpmvv::make_stepper(disk_model(Method::linear), SolverOptions{Method::linear, Scheme::usl},
+                                    MaterialModel{kSolid}, nullptr);
+  EXPECT_EQ(linear->bytes_per_particle(), 136.0);
+  auto gimp = mpmvv::make_stepper(disk_model(Method::gimp), SolverOptions{Method::gimp, Scheme::usl},
+                                  MaterialModel{kSolid}, nullptr);
+  EXPECT_EQ(gimp->bytes_per_particle(), 152.0);
+  auto musl = mpmvv::make_stepper(disk_model(Method::gimp), SolverOptions{Method::gimp, Scheme::musl},
+                                  MaterialModel{kSolid}, nullptr);
+  EXPECT_EQ(musl->bytes_per_particle(), 168.0);
+}
+
 // A stepper whose stage gives up at its third step, as a system of rest
 // points that does not factor does.
 class GivingUpStepper final : public Stepper {
