@@ -532,10 +532,14 @@ template <class Shape>
 bool particle_healthy(const Shape& shape, const Particles& P, std::size_t p) {
   const double F33 = out_of_plane_stretch<Shape::geometry>(P, p);
   const double J = determinant(P.deformation_gradient[p]) * F33;
-  bool finite = P.position[p].allFinite() && P.velocity[p].allFinite() && P.deformation_gradient[p].allFinite() &&
-                P.stress[p].allFinite();
-  if constexpr (Shape::geometry == Geometry::axisymmetric) finite = finite && std::isfinite(P.hoop_stress[p]);
-  return finite && J > 0.0 && shape.inside(p);
+  // 0 x is +-0 for a finite x and NaN for an infinite or NaN one: the sum of
+  // the products is zero exactly when every entry is finite, with no branch
+  // per entry (the test runs for every particle every step).
+  double zero = 0.0 * (P.position[p].x()) + 0.0 * (P.position[p].y()) + 0.0 * (P.velocity[p].x()) +
+                0.0 * (P.velocity[p].y());
+  for (int k = 0; k < 4; ++k) zero += 0.0 * P.deformation_gradient[p](k) + 0.0 * P.stress[p](k);
+  if constexpr (Shape::geometry == Geometry::axisymmetric) zero += 0.0 * P.hoop_stress[p];
+  return zero == 0.0 && J > 0.0 && shape.inside(p);
 }
 
 // The sum over nodes of |G_gp| of a stencil, each node counted once: a full

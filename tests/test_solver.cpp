@@ -1212,6 +1212,15 @@ TEST(TimeLoop, AStepPreparedByItsMapScansAndMovesAsOneThatMapsItself) {
     auto stopped = mpmvv::make_stepper(broken, options, MaterialModel{kSolid}, nullptr);
     EXPECT_EQ(stopped->scan().first_unhealthy, 4u);
     EXPECT_EQ(stopped->prepare_step(0.0).first_unhealthy, 4u);
+    broken.particles.deformation_gradient[4] = F;
+    broken.particles.stress[12](1, 0) = std::numeric_limits<double>::infinity();
+    auto nan = mpmvv::make_stepper(broken, options, MaterialModel{kSolid}, nullptr);
+    EXPECT_EQ(nan->scan().first_unhealthy, 9u);
+    EXPECT_EQ(nan->prepare_step(0.0).first_unhealthy, 9u);
+    broken.particles.velocity[9].x() = 0.0;
+    auto infinite = mpmvv::make_stepper(broken, options, MaterialModel{kSolid}, nullptr);
+    EXPECT_EQ(infinite->scan().first_unhealthy, 12u);
+    EXPECT_EQ(infinite->prepare_step(0.0).first_unhealthy, 12u);
   }
 }
 
