@@ -9,8 +9,11 @@
 // each loop stays free of a branch per particle.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <vector>
+
+#include "../geometry.hpp"
 
 #include "stencil.hpp"
 
@@ -24,13 +27,25 @@ inline constexpr bool kStoresStencils = [] {
   return false;
 }();
 
+// Copies the entries of a stencil that are in use (its first `count`; the
+// hoop weights only in r-z, where a shape sets them).
+template <class Shape>
+void copy_stencil(const Stencil<Shape::stencil_size>& from, Stencil<Shape::stencil_size>& to) {
+  const int n = from.count;
+  to.count = n;
+  std::copy_n(from.node, n, to.node);
+  std::copy_n(from.weight, n, to.weight);
+  std::copy_n(from.gradient, n, to.gradient);
+  if constexpr (Shape::geometry == Geometry::axisymmetric) std::copy_n(from.hoop, n, to.hoop);
+}
+
 // Evaluates as Shape does and keeps each stencil in `store` (one per particle).
 template <class Shape>
 struct StencilRecorder : Shape {
   Stencil<Shape::stencil_size>* store;
   void evaluate(std::size_t p, Stencil<Shape::stencil_size>& s) const {
     Shape::evaluate(p, s);
-    store[p] = s;
+    copy_stencil<Shape>(s, store[p]);
   }
 };
 
@@ -38,7 +53,7 @@ struct StencilRecorder : Shape {
 template <class Shape>
 struct StencilReader : Shape {
   const Stencil<Shape::stencil_size>* store;
-  void evaluate(std::size_t p, Stencil<Shape::stencil_size>& s) const { s = store[p]; }
+  void evaluate(std::size_t p, Stencil<Shape::stencil_size>& s) const { copy_stencil<Shape>(store[p], s); }
 };
 
 }  // namespace mpmvv
