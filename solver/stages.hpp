@@ -15,7 +15,6 @@
 #include <cstddef>
 #include <limits>
 #include <type_traits>
-#include <utility>
 #include <vector>
 
 #include "geometry.hpp"
@@ -47,17 +46,12 @@ struct NodeSums {
   double mass, momentum_x, momentum_y, force_x, force_y;
 };
 
-// One scatter buffer per thread, each covering the whole grid but zero
-// outside the nodes its thread's particles reach: a map reads and clears only
-// [touched.first, touched.second) of each, which with particles split into
-// contiguous ranges over threads is about a thread's share of the body.
+// One scatter buffer per thread, each covering the whole grid.
 struct ScatterBuffers {
   std::vector<std::vector<NodeSums>> per_thread;
-  std::vector<std::pair<std::size_t, std::size_t>> touched;  // per thread, nodes of the map in progress
 
   void resize(int threads, std::size_t nodes) {
     per_thread.assign(std::size_t(threads), std::vector<NodeSums>(nodes));
-    touched.assign(std::size_t(threads), {0, 0});
   }
 };
 
@@ -95,9 +89,8 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
 
 #pragma omp parallel num_threads(threads)
   {
-    const std::size_t own = std::size_t(thread_id());
-    NodeSums* sums = buffers.per_thread[own].data();
-    int lowest = std::numeric_limits<int>::max(), highest = -1;  // the nodes this thread reaches
+    NodeSums* sums = buffers.per_thread[std::size_t(thread_id())].data();
+    std::fill(sums, sums + nodes, NodeSums{0.0, 0.0, 0.0, 0.0, 0.0});
     Stencil<Shape::stencil_size> s;
     [[maybe_unused]] double max_speed = 0.0;
     [[maybe_unused]] std::size_t first_unhealthy = P.size();
@@ -120,8 +113,6 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
       if constexpr (with_internal) volume_stress = P.volume[p] * P.stress[p];
       if constexpr (with_internal && axisymmetric) volume_hoop_stress = P.volume[p] * P.hoop_stress[p];
       for (int k = 0; k < s.count; ++k) {
-        lowest = std::min(lowest, s.node[k]);
-        highest = std::max(highest, s.node[k]);
         NodeSums& node = sums[s.node[k]];
         const double w = s.weight[k];
         if constexpr (with_mass) node.mass += w * m;
@@ -151,25 +142,12 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
         scan->result.first_unhealthy = std::min(scan->result.first_unhealthy, first_unhealthy);
       }
     }
-    buffers.touched[own] = highest < 0 ? std::pair<std::size_t, std::size_t>{0, 0}
-                                       : std::pair<std::size_t, std::size_t>{std::size_t(lowest), std::size_t(highest) + 1};
-#pragma omp barrier
-    // All buffers are complete. A node beyond a thread's reach holds zero
-    // there, so leaving it out of the sum changes nothing: the sums are those
-    // of every buffer in thread order.
+    // The implicit barrier of the particles' `omp for` above: all buffers are complete.
 #pragma omp for schedule(static)
     for (std::size_t i = 0; i < nodes; ++i) {
-      NodeSums total{0.0, 0.0, 0.0, 0.0, 0.0};
-      bool first = true;
-      for (int t = 0; t < threads; ++t) {
-        const auto [from, to] = buffers.touched[std::size_t(t)];
-        if (i < from || i >= to) continue;
+      NodeSums total = buffers.per_thread[0][i];
+      for (int t = 1; t < threads; ++t) {
         const NodeSums& b = buffers.per_thread[std::size_t(t)][i];
-        if (first) {
-          total = b;
-          first = false;
-          continue;
-        }
         total.mass += b.mass;
         total.momentum_x += b.momentum_x;
         total.momentum_y += b.momentum_y;
@@ -180,10 +158,6 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
       if constexpr (with_momentum) g.momentum[i] = Vec2(total.momentum_x, total.momentum_y);
       if constexpr (with_force) g.force[i] = Vec2(total.force_x, total.force_y);
     }
-    // (The loop's barrier: every thread has read every buffer.) Each thread
-    // leaves its buffer zero for the next map.
-    const auto [from, to] = buffers.touched[own];
-    std::fill(sums + from, sums + to, NodeSums{0.0, 0.0, 0.0, 0.0, 0.0});
   }
 }
 
