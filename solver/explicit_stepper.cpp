@@ -156,9 +156,8 @@ class ExplicitStepper final : public Stepper {
 
   double bytes_per_particle() const override {
     const std::size_t n = model_.particles.size();
-    auto of = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
-    const std::size_t own = of(stencils_) + of(next_position_) + of(next_corner_) + of(step_start_deformation_) +
-                            of(volume_before_);
+    const std::size_t own = bytes_held(stencils_) + bytes_held(next_position_) + bytes_held(next_corner_) +
+                            bytes_held(step_start_deformation_) + bytes_held(volume_before_);
     return n ? double(model_.particles.bytes() + own) / double(n) : 0.0;
   }
 

@@ -11,6 +11,12 @@
 
 namespace mpmvv {
 
+// The bytes a vector holds (its capacity).
+template <class T>
+std::size_t bytes_held(const std::vector<T>& v) {
+  return v.capacity() * sizeof(T);
+}
+
 struct Particles {
   // Advanced by every step.
   std::vector<Vec2> position;              // x_p
@@ -65,11 +71,11 @@ struct Particles {
 
   // The bytes the arrays hold (their capacity).
   std::size_t bytes() const {
-    auto of = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
-    return of(position) + of(velocity) + of(deformation_gradient) + of(volume) + of(stress) + of(mass) +
-           of(reference_volume) + of(reference_position) + of(half_size) + of(domain_axes) + of(domain_corner) +
-           of(domain_first) + of(domain_vertex) + of(hoop_stretch) + of(hoop_stress) + of(affine_velocity) +
-           of(body_force);
+    return bytes_held(position) + bytes_held(velocity) + bytes_held(deformation_gradient) + bytes_held(volume) +
+           bytes_held(stress) + bytes_held(mass) + bytes_held(reference_volume) + bytes_held(reference_position) +
+           bytes_held(half_size) + bytes_held(domain_axes) + bytes_held(domain_corner) + bytes_held(domain_first) +
+           bytes_held(domain_vertex) + bytes_held(hoop_stretch) + bytes_held(hoop_stress) +
+           bytes_held(affine_velocity) + bytes_held(body_force);
   }
 
   // A_p: the columns span particle p's reference domain about X_p.

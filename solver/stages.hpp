@@ -547,12 +547,12 @@ bool particle_healthy(const Shape& shape, const Particles& P, std::size_t p) {
 // corner that reaches it); one that is not full (cpdi.hpp) lists each node
 // once already.
 template <int N>
+double entry_gradient_sum(const Stencil<N>& s);
+
+template <int N>
 double gradient_sum(const Stencil<N>& s) {
+  if (s.count < N) return entry_gradient_sum(s);
   double sum = 0.0;
-  if (s.count < N) {
-    for (int k = 0; k < s.count; ++k) sum += s.gradient[k].norm();
-    return sum;
-  }
   for (int k = 0; k < s.count; ++k) {
     bool first = true;
     for (int j = 0; j < k && first; ++j) first = s.node[j] != s.node[k];
@@ -562,6 +562,16 @@ double gradient_sum(const Stencil<N>& s) {
       if (s.node[j] == s.node[k]) g += s.gradient[j];
     sum += g.norm();
   }
+  return sum;
+}
+
+// The sum of |G_gp| over a stencil's entries as listed: at least the sum over
+// nodes above (the triangle inequality), and equal to it, in the same order
+// of additions, where no node repeats.
+template <int N>
+double entry_gradient_sum(const Stencil<N>& s) {
+  double sum = 0.0;
+  for (int k = 0; k < s.count; ++k) sum += s.gradient[k].norm();
   return sum;
 }
 
@@ -637,17 +647,12 @@ double signal_speed(const Shape& shape, const Material& material, const Particle
     const double c_small = std::sqrt(material.p_wave_modulus() / density);
     // With the stencil at hand the bound is its sum of |G| over entries, which
     // is k_p's own sum where no node repeats (a stencil that is not full).
-    double bound = 0.0;
-    if (stencil) {
-      for (int k = 0; k < stencil->count; ++k) bound += stencil->gradient[k].norm();
-    } else {
-      bound = shape.gradient_sum_bound(p);
-    }
+    const double bound = stencil ? entry_gradient_sum(*stencil) : shape.gradient_sum_bound(p);
     const double most = std::max(1.0, h * bound / kGridBasisGradientBound);
     if (std::max(c, most * c_small) + v > largest) {
-      double k = most;
-      if (!stencil) k = stiffening(shape, p, h);
-      else if (stencil->count == Shape::stencil_size) k = stiffening(*stencil, h);
+      const double k = !stencil                                  ? stiffening(shape, p, h)
+                       : stencil->count < Shape::stencil_size ? most
+                                                                 : stiffening(*stencil, h);
       if (k > 1.0) speed = std::max(c, k * c_small);
     }
   }
