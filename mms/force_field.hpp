@@ -28,23 +28,40 @@
 
 namespace mpmvv::mms {
 
-// b(X, t) at a set of reference points fixed between calls to prepare().
+// b(X, t) at a set of reference points fixed between calls to prepare() or
+// place(). A field may keep factors of each point that do not change with time.
 class ForceField {
  public:
   virtual ~ForceField() = default;
-  // The points the field is evaluated at from now on; a field may keep
-  // factors of each point that do not change with time.
-  virtual void prepare(const std::vector<Vec2>& points) = 0;
-  // b at every prepared point [m/s^2].
+  // The field is evaluated at `count` points from now on: point index[k] is
+  // (re)placed at at[k], and the others keep where they were. A split (split.hpp)
+  // moves its parents and appends its halves; only those are placed again.
+  virtual void place(std::size_t count, const std::vector<std::size_t>& index, const std::vector<Vec2>& at) = 0;
+  // b at every point [m/s^2].
   virtual void evaluate(double t, std::vector<Vec2>& b) const = 0;
+  // All points placed anew.
+  void prepare(const std::vector<Vec2>& points) {
+    std::vector<std::size_t> index(points.size());
+    for (std::size_t k = 0; k < index.size(); ++k) index[k] = k;
+    place(points.size(), index, points);
+  }
 };
+
+// ForceField::place for a field that keeps its points as they are.
+inline void place_points(std::vector<Vec2>& points, std::size_t count, const std::vector<std::size_t>& index,
+                         const std::vector<Vec2>& at) {
+  points.resize(count);
+  for (std::size_t k = 0; k < index.size(); ++k) points[index[k]] = at[k];
+}
 
 // The force derived from the motion and material by automatic
 // differentiation (manufactured.hpp).
 class DerivedForceField final : public ForceField {
  public:
   explicit DerivedForceField(std::shared_ptr<const ExactSolution> solution) : solution_(std::move(solution)) {}
-  void prepare(const std::vector<Vec2>& points) override { points_ = points; }
+  void place(std::size_t count, const std::vector<std::size_t>& index, const std::vector<Vec2>& at) override {
+    place_points(points_, count, index, at);
+  }
   void evaluate(double t, std::vector<Vec2>& b) const override { solution_->body_forces(t, points_, b); }
 
  private:
@@ -77,38 +94,17 @@ class ManufacturedBodyForce final : public BodyForce {
   ForceQuadrature quadrature() const { return quadrature_; }
 
   void prepare(const Particles& P) override {
-    const std::size_t n = P.size();
-    if (quadrature_ == ForceQuadrature::centroid) {
-      field_->prepare(P.reference_position);
-      prepared_for_ = n;
-      return;
-    }
-    const bool axisymmetric = geometry_ == Geometry::axisymmetric;
-    std::vector<Vec2> points(kPoints * n);
-    weight_.resize(kPoints * n);
-    // The 2 x 2 Gauss points of [-1, 1]^2 at +-1/sqrt(3).
-    const double g = 1.0 / std::sqrt(3.0);
-    for (std::size_t p = 0; p < n; ++p) {
-      const Vec2& X = P.reference_position[p];
-      Mat2 a;
-      if (P.half_size.size() == n) {
-        a = P.reference_domain(p);
-      } else {
-        const double area = axisymmetric ? P.reference_volume[p] / X.x() : P.reference_volume[p];
-        a = 0.5 * std::sqrt(area) * Mat2::Identity();
-      }
-      double total = 0.0;
-      for (std::size_t k = 0; k < kPoints; ++k) {
-        const Vec2 Y = X + g * (a * Vec2(k % 2 == 0 ? -1.0 : 1.0, k / 2 == 0 ? -1.0 : 1.0));
-        points[kPoints * p + k] = Y;
-        weight_[kPoints * p + k] = axisymmetric ? Y.x() : 1.0;
-        total += weight_[kPoints * p + k];
-      }
-      for (std::size_t k = 0; k < kPoints; ++k) weight_[kPoints * p + k] /= total;
-    }
-    field_->prepare(points);
-    at_points_.resize(points.size());
-    prepared_for_ = n;
+    std::vector<std::size_t> all(P.size());
+    for (std::size_t p = 0; p < all.size(); ++p) all[p] = p;
+    place_particles(P, all);
+  }
+
+  // Only the particles a split changed or appended are placed again: the
+  // others' points, and what the field keeps for them, still hold.
+  void update(const Particles& P, std::size_t previous_count, const std::vector<std::size_t>& changed) override {
+    std::vector<std::size_t> particles = changed;
+    for (std::size_t p = previous_count; p < P.size(); ++p) particles.push_back(p);
+    place_particles(P, particles);
   }
 
   void evaluate(double t, const Particles& P, std::vector<Vec2>& b) const override {
@@ -129,6 +125,49 @@ class ManufacturedBodyForce final : public BodyForce {
 
  private:
   static constexpr std::size_t kPoints = 4;
+
+  // Places the sample points of the listed particles, for a set of P.size().
+  void place_particles(const Particles& P, const std::vector<std::size_t>& particles) {
+    const std::size_t n = P.size(), m = particles.size();
+    if (quadrature_ == ForceQuadrature::centroid) {
+      std::vector<Vec2> at(m);
+      for (std::size_t k = 0; k < m; ++k) at[k] = P.reference_position[particles[k]];
+      field_->place(n, particles, at);
+      prepared_for_ = n;
+      return;
+    }
+    const bool axisymmetric = geometry_ == Geometry::axisymmetric;
+    const bool domains = P.half_size.size() == n;
+    std::vector<std::size_t> index(kPoints * m);
+    std::vector<Vec2> at(kPoints * m);
+    weight_.resize(kPoints * n);
+    // The 2 x 2 Gauss points of [-1, 1]^2 at +-1/sqrt(3).
+    const double g = 1.0 / std::sqrt(3.0);
+#pragma omp parallel for schedule(static)
+    for (std::size_t k = 0; k < m; ++k) {
+      const std::size_t p = particles[k];
+      const Vec2& X = P.reference_position[p];
+      Mat2 a;
+      if (domains) {
+        a = P.reference_domain(p);
+      } else {
+        const double area = axisymmetric ? P.reference_volume[p] / X.x() : P.reference_volume[p];
+        a = 0.5 * std::sqrt(area) * Mat2::Identity();
+      }
+      double total = 0.0;
+      for (std::size_t j = 0; j < kPoints; ++j) {
+        const Vec2 Y = X + g * (a * Vec2(j % 2 == 0 ? -1.0 : 1.0, j / 2 == 0 ? -1.0 : 1.0));
+        index[kPoints * k + j] = kPoints * p + j;
+        at[kPoints * k + j] = Y;
+        weight_[kPoints * p + j] = axisymmetric ? Y.x() : 1.0;
+        total += weight_[kPoints * p + j];
+      }
+      for (std::size_t j = 0; j < kPoints; ++j) weight_[kPoints * p + j] /= total;
+    }
+    field_->place(kPoints * n, index, at);
+    at_points_.resize(kPoints * n);
+    prepared_for_ = n;
+  }
   std::shared_ptr<ForceField> field_;
   ForceQuadrature quadrature_;
   Geometry geometry_;

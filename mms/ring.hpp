@@ -215,12 +215,15 @@ class RingClosedFormField final : public ForceField {
  public:
   explicit RingClosedFormField(const RingMms& mms) : mms_(mms) {}
 
-  void prepare(const std::vector<Vec2>& points) override {
-    radial_.clear();
-    direction_.clear();
-    for (const Vec2& X : points) {
-      radial_.push_back(mms_.radial(X.norm()));
-      direction_.push_back(X / X.norm());
+  void place(std::size_t count, const std::vector<std::size_t>& index, const std::vector<Vec2>& at) override {
+    radial_.resize(count);
+    direction_.resize(count);
+    const std::size_t n = index.size();
+#pragma omp parallel for schedule(static)
+    for (std::size_t k = 0; k < n; ++k) {
+      const Vec2& X = at[k];
+      radial_[index[k]] = mms_.radial(X.norm());
+      direction_[index[k]] = X / X.norm();
     }
   }
 

@@ -116,9 +116,11 @@ class ExplicitStepper final : public Stepper {
     // turned first, and a split then halves the turned domain.
     if constexpr (Shape::reads_deformation_gradient) {
       if constexpr (kTurnedDomains) open_sheared_domains(model_.particles, open_cos_);
-      if (split_length_ > 0.0 && split_long_domains(model_.particles, split_length_) > 0) {
+      const std::size_t before = model_.particles.size();
+      split_parents_.clear();
+      if (split_length_ > 0.0 && split_long_domains(model_.particles, split_length_, &split_parents_) > 0) {
         if (scheme_ == Scheme::musl) next_position_.resize(model_.particles.size());
-        if (body_force_) body_force_->prepare(model_.particles);
+        if (body_force_) body_force_->update(model_.particles, before, split_parents_);
       }
     }
   }
@@ -609,6 +611,7 @@ class ExplicitStepper final : public Stepper {
   std::vector<std::vector<Vec2>> gradient_buffers_;
   ScatterBuffers buffers_;
   std::vector<Vec2> next_position_;  // MUSL only: x_{n+1} while x_n still sets the weights
+  std::vector<std::size_t> split_parents_;  // split_long_domains: the particles a split cut in the last step
   std::vector<Vec2> next_corner_;    // MUSL with corner domains: the corners at t_{n+1}, likewise
   std::vector<Mat2> step_start_deformation_;  // USF with CPDI only: F_n, which sets the domains
   std::vector<Vec2> tracer_reference_;         // total Lagrangian: where each tracer reads the grid

@@ -82,6 +82,13 @@ class BodyForce {
   // and again whenever the set changes (split.hpp appends halves): a force may
   // keep per-particle factors that hold while the set does.
   virtual void prepare(const Particles&) {}
+  // After a split (split.hpp): the particles listed in `changed` were altered
+  // in place and those from `previous_count` on are new. A force that keeps
+  // per-particle factors may renew only theirs; by default all are prepared.
+  virtual void update(const Particles& particles, std::size_t /*previous_count*/,
+                      const std::vector<std::size_t>& /*changed*/) {
+    prepare(particles);
+  }
   virtual void evaluate(double t, const Particles& particles, std::vector<Vec2>& body_force) const = 0;
 };
 

@@ -24,6 +24,7 @@
 #pragma once
 
 #include <cstddef>
+#include <vector>
 
 #include "domain_corners.hpp"
 #include "particles.hpp"
@@ -52,19 +53,43 @@ inline void split_corners(std::vector<Vec2>& corners, std::size_t p, int axis) {
 
 // Splits, in place, every particle whose domain length 2 |r_i| along either
 // vector exceeds `max_length`, as often as it takes (each half is checked
-// again). Returns the number of splits.
-inline std::size_t split_long_domains(Particles& P, double max_length) {
-  std::size_t splits = 0;
+// again). Returns the number of splits; `changed`, when given, receives each
+// particle present before that was split (it keeps one half), in order.
+inline std::size_t split_long_domains(Particles& P, double max_length, std::vector<std::size_t>* changed = nullptr) {
   const bool turned = !P.domain_axes.empty();
   const bool corners = !P.domain_corner.empty();
+  // Particle p's reference and current half-vectors, and the axis along
+  // which it is too long (-1 when it is not).
+  struct Cut {
+    Mat2 a, s;
+    int axis;
+  };
+  auto cut_of = [&](std::size_t p) {
+    Cut c;
+    c.a = P.reference_domain(p);
+    c.s = corners ? corner_half_vectors(&P.domain_corner[4 * p]) : Mat2(P.deformation_gradient[p] * c.a);
+    const double long1 = 2.0 * c.s.col(0).norm(), long2 = 2.0 * c.s.col(1).norm();
+    c.axis = !(long1 > max_length || long2 > max_length) ? -1  // NaN stays: the health scan reports it
+             : long1 >= long2                             ? 0
+                                                          : 1;
+    return c;
+  };
+  // The particles present are measured in parallel; the few that split are
+  // then cut one after another, in the order of a single pass.
+  const std::size_t present = P.size();
+  std::vector<unsigned char> too_long(present);
+#pragma omp parallel for schedule(static)
+  for (std::size_t p = 0; p < present; ++p) too_long[p] = cut_of(p).axis >= 0;
+  std::size_t splits = 0;
   for (std::size_t p = 0; p < P.size(); ++p) {
+    if (p < present && !too_long[p]) continue;
+    if (changed && p < present) changed->push_back(p);
     for (;;) {
-      const Mat2 a = P.reference_domain(p);
-      const Mat2 s = corners ? corner_half_vectors(&P.domain_corner[4 * p]) : Mat2(P.deformation_gradient[p] * a);
-      const double long1 = 2.0 * s.col(0).norm(), long2 = 2.0 * s.col(1).norm();
-      if (!(long1 > max_length || long2 > max_length)) break;  // NaN stays: the health scan reports it
-      const int axis = long1 >= long2 ? 0 : 1;
-      const Vec2 r = s.col(axis);
+      const Cut cut = cut_of(p);
+      const int axis = cut.axis;
+      if (axis < 0) break;
+      const Mat2& a = cut.a;
+      const Vec2 r = cut.s.col(axis);
       const Vec2 reference_step = 0.5 * a.col(axis);
       const std::size_t q = P.size();
       P.resize(q + 1);

@@ -14,6 +14,7 @@
 
 #include "mms/force_field.hpp"
 #include "mms/ring.hpp"
+#include "solver/split.hpp"
 
 namespace {
 
@@ -29,7 +30,9 @@ using Field = std::function<Vec2(const Vec2&)>;
 class FunctionField final : public ForceField {
  public:
   explicit FunctionField(Field f) : f_(std::move(f)) {}
-  void prepare(const std::vector<Vec2>& points) override { points_ = points; }
+  void place(std::size_t count, const std::vector<std::size_t>& index, const std::vector<Vec2>& at) override {
+    mpmvv::mms::place_points(points_, count, index, at);
+  }
   void evaluate(double, std::vector<Vec2>& b) const override {
     for (std::size_t k = 0; k < points_.size(); ++k) b[k] = f_(points_[k]);
   }
@@ -200,4 +203,35 @@ TEST(ForceQuadrature, DomainRuleRemovesTheRingForcesTorqueError) {
   RecordProperty("centroid_torque_error", std::to_string(centroid_error));
   RecordProperty("domain_torque_error", std::to_string(domain_error));
   EXPECT_GT(centroid_error, 20.0 * domain_error) << centroid_error << " against " << domain_error;
+}
+
+// After a split only the cut particles and the new halves are placed again
+// (ManufacturedBodyForce::update); every particle's force then equals the one
+// a force prepared afresh for the new set gives, bit for bit, under both rules
+// and with the ring's closed form, which keeps factors per point.
+TEST(ForceQuadrature, ASplitPlacesOnlyWhatItChanged) {
+  const mpmvv::mms::RingMms ring(mpmvv::mms::RingParameters{});
+  const std::vector<Vec2> X = {{0.8, 0.1}, {0.9, -0.3}, {-0.2, 1.0}, {0.5, 0.7}, {-1.1, -0.2}};
+  for (const ForceQuadrature q : {ForceQuadrature::centroid, ForceQuadrature::domain}) {
+    Particles P = particles_at(X, Vec2(0.03, 0.05));
+    P.deformation_gradient.assign(P.size(), mpmvv::Mat2::Identity());
+    P.deformation_gradient[1](0, 1) = 3.0;  // sheared: its domain is 2 |F (0, l_y)| = 0.32 m long
+    P.deformation_gradient[3](0, 0) = 2.5;  // stretched: 0.15 m
+    ManufacturedBodyForce updated(std::make_shared<mpmvv::mms::RingClosedFormField>(ring), q, Geometry::plane_strain);
+    updated.prepare(P);
+    const std::size_t before = P.size();
+    std::vector<std::size_t> changed;
+    ASSERT_GT(mpmvv::split_long_domains(P, 0.12, &changed), 2u);
+    EXPECT_EQ(changed, (std::vector<std::size_t>{1, 3}));
+    updated.update(P, before, changed);
+    ManufacturedBodyForce fresh(std::make_shared<mpmvv::mms::RingClosedFormField>(ring), q, Geometry::plane_strain);
+    fresh.prepare(P);
+    std::vector<Vec2> a(P.size()), b(P.size());
+    updated.evaluate(0.37, P, a);
+    fresh.evaluate(0.37, P, b);
+    for (std::size_t p = 0; p < P.size(); ++p) {
+      EXPECT_EQ(a[p].x(), b[p].x()) << "particle " << p << ", " << mpmvv::mms::to_string(q);
+      EXPECT_EQ(a[p].y(), b[p].y()) << "particle " << p << ", " << mpmvv::mms::to_string(q);
+    }
+  }
 }
