@@ -185,6 +185,10 @@ TEST(CpdiExactShape, AgreesWithTheCornerFormulaInsideOneCell) {
     const Vec2 centre = grid.origin + grid.h * Vec2(5.5 + offset(rng), 6.5 + offset(rng));
     const Particles P = one_particle(centre, F, grid.h * Vec2(0.12, 0.1));
     ASSERT_TRUE(CpdiExactShape::bind(grid, P).inside(0));
+    // The stencil lists the cell's four nodes only, not the block's 16.
+    Stencil<CpdiExactShape::stencil_size> listed;
+    CpdiExactShape::bind(grid, P).evaluate(0, listed);
+    EXPECT_EQ(listed.count, 4);
     const std::map<int, NodeValues> exact = stencil_of<CpdiExactShape>(grid, P);
     const std::map<int, NodeValues> corners = stencil_of<CpdiShape>(grid, P);
     ASSERT_EQ(exact.size(), corners.size());

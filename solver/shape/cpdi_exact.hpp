@@ -243,19 +243,39 @@ struct CpdiExactShapeT {
     Vec2 grad[stencil_size];
     for (Vec2& v : grad) v.setZero();
     // Each cell of the block: clip, take the moments about the cell's corner.
-    Vec2 a[kClipBuffer], b[kClipBuffer], piece[kClipBuffer];
+    // A clip whose half-plane holds every point of the polygon would return
+    // it point for point, so it is skipped: a domain within one cell is not
+    // clipped at all.
+    Vec2 row_a[kClipBuffer], row_b[kClipBuffer], a[kClipBuffer], piece[kClipBuffer];
     double area = 0.0;  // int dA, or in r-z int r dA (cells^3)
+    int last_ci = 0, last_cj = 0;  // the farthest cell of the block the domain meets
+    // The rows the polygon's points span (in r-z after the cut at the axis,
+    // whose new points may round beyond the outline's box).
+    double y_lo = lo.y(), y_hi = hi.y();
+    if constexpr (radial) {
+      Vec2 cut_lo, cut_hi;
+      bounds(c, count, cut_lo, cut_hi);
+      y_lo = cut_lo.y(), y_hi = cut_hi.y();
+    }
     for (int cj = 0; cj < block - 1 && j0 + cj < g.cells_y; ++cj) {
       if (j0 + cj >= hi.y()) break;
-      int n = clip_polygon(c, count, 1, j0 + cj, true, a, kClipBuffer);
-      n = clip_polygon(a, n, 1, j0 + cj + 1, false, b, kClipBuffer);
+      const Vec2* row = c;
+      int n = count;
+      if (!(y_lo >= j0 + cj)) n = clip_polygon(row, n, 1, j0 + cj, true, row_a, kClipBuffer), row = row_a;
+      if (!(y_hi <= j0 + cj + 1)) n = clip_polygon(row, n, 1, j0 + cj + 1, false, row_b, kClipBuffer), row = row_b;
       if (n < 3) continue;
+      double row_lo = row[0].x(), row_hi = row[0].x();
+      for (int k = 1; k < n; ++k) row_lo = std::min(row_lo, row[k].x()), row_hi = std::max(row_hi, row[k].x());
       for (int ci = 0; ci < block - 1 && i0 + ci < g.cells_x; ++ci) {
         if (i0 + ci >= hi.x()) break;
-        int m = clip_polygon(b, n, 0, i0 + ci, true, a, kClipBuffer);
-        m = clip_polygon(a, m, 0, i0 + ci + 1, false, piece, kClipBuffer);
+        const Vec2* cell = row;
+        int m = n;
+        if (!(row_lo >= i0 + ci)) m = clip_polygon(cell, m, 0, i0 + ci, true, a, kClipBuffer), cell = a;
+        if (!(row_hi <= i0 + ci + 1)) m = clip_polygon(cell, m, 0, i0 + ci + 1, false, piece, kClipBuffer), cell = piece;
         if (m < 3) continue;
-        for (int k = 0; k < m; ++k) piece[k] -= Vec2(i0 + ci, j0 + cj);
+        last_ci = std::max(last_ci, ci);
+        last_cj = std::max(last_cj, cj);
+        for (int k = 0; k < m; ++k) piece[k] = cell[k] - Vec2(i0 + ci, j0 + cj);
         const PolygonMoments q = polygon_moments<radial>(piece, m);
         // Nodes (0,0), (1,0), (0,1), (1,1) of the cell in the block.
         const int k00 = cj * block + ci, k10 = k00 + 1, k01 = k00 + block, k11 = k01 + 1;
@@ -286,23 +306,26 @@ struct CpdiExactShapeT {
       }
     }
     // Divide by the domain's area (in cells^2; in r-z its int r dA, in cells^3)
-    // and turn d/du into d/dx. In r-z <S/r> = int S dA / int r dA.
+    // and turn d/du into d/dx. In r-z <S/r> = int S dA / int r dA. Only the
+    // nodes of the cells the domain meets are listed, each once (a domain
+    // within one cell has 4 of the block's 16): the others' entries are zero,
+    // and the transfers and the stored stencils (stored_stencils.hpp) skip them.
     const double inv_area = 1.0 / area, gradient_factor = gradient_scale * inv_area / g.h;
-    const int nx = g.nodes_x(), last_i = g.cells_x, last_j = g.cells_y;
-    for (int kj = 0; kj < block; ++kj)
-      for (int ki = 0; ki < block; ++ki) {
+    const int nx = g.nodes_x();
+    int n = 0;
+    for (int kj = 0; kj <= last_cj + 1; ++kj)
+      for (int ki = 0; ki <= last_ci + 1; ++ki, ++n) {
         const int k = kj * block + ki;
-        // Nodes beyond the grid carry nothing; name an existing node for them.
-        const int i = std::min(i0 + ki, last_i), j = std::min(j0 + kj, last_j);
-        st.node[k] = j * nx + i;
-        st.gradient[k] = gradient_factor * grad[k];
+        st.node[n] = (j0 + kj) * nx + i0 + ki;
+        st.gradient[n] = gradient_factor * grad[k];
         if constexpr (radial) {
-          st.weight[k] = radial_mass[k] * inv_area;
-          st.hoop[k] = mass[k] * inv_area / g.h;
+          st.weight[n] = radial_mass[k] * inv_area;
+          st.hoop[n] = mass[k] * inv_area / g.h;
         } else {
-          st.weight[k] = mass[k] * inv_area;
+          st.weight[n] = mass[k] * inv_area;
         }
       }
+    st.count = n;
   }
 
   // The centre between the walls (in r-z off the axis), the whole outline in
