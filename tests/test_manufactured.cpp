@@ -594,6 +594,44 @@ TEST(RingClosedForm, ClosedFormFieldEqualsDerivedField) {
   }
 }
 
+// ---------------------------------------------------------------- the axis-aligned closed form
+
+// The axis-aligned motion's closed-form force (AxisAlignedClosedFormField)
+// fills the same vectors as the derived field over the square (2D) and the
+// strip (1D) at several times, for the problem's material and at an amplitude
+// of a tenth of the side (strains of 0.3 and 0.6): the largest difference is
+// below 1e-12 of the largest force.
+TEST(AxisAlignedClosedForm, ClosedFormFieldEqualsDerivedField) {
+  const NeoHookean material{5769.23, 3846.15};
+  for (const bool one_d : {false, true})
+    for (const double amplitude : {0.05, 0.1}) {
+      const mpmvv::mms::AxisAlignedMotion motion{amplitude, 100.0, 1.0, one_d};
+      std::mt19937 rng(31);
+      std::uniform_real_distribution<double> unit(0.0, 1.0);
+      std::vector<Vec2> X(400);
+      for (Vec2& x : X) x = Vec2(unit(rng), one_d ? 0.05 * unit(rng) : unit(rng));
+      mpmvv::mms::AxisAlignedClosedFormField closed(motion, material, 1.0);
+      closed.prepare(X);
+      mpmvv::mms::DerivedForceField derived(mpmvv::mms::make_solution(motion, material, 1.0, Geometry::plane_strain));
+      derived.prepare(X);
+      double worst_relative = 0.0;
+      for (double t : {0.0, 0.0013, 0.004, 0.0071, 0.02}) {
+        std::vector<Vec2> b_closed(X.size()), b_derived(X.size());
+        closed.evaluate(t, b_closed);
+        derived.evaluate(t, b_derived);
+        double largest = 0.0, worst = 0.0;
+        for (std::size_t k = 0; k < X.size(); ++k) {
+          largest = std::max(largest, b_derived[k].norm());
+          worst = std::max(worst, (b_closed[k] - b_derived[k]).norm());
+        }
+        ASSERT_GT(largest, 0.0);
+        EXPECT_LT(worst, 1e-12 * largest) << (one_d ? "1d" : "2d") << ", A = " << amplitude << ", t = " << t;
+        worst_relative = std::max(worst_relative, worst / largest);
+      }
+      RecordProperty(std::string(one_d ? "1d" : "2d") + "_A" + std::to_string(amplitude), scientific(worst_relative));
+    }
+}
+
 // ---------------------------------------------------------------- initial conditions
 
 // The axis-aligned 2D motion starts displaced: u_y(X, 0) = A sin(pi Y)

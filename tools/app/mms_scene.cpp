@@ -54,6 +54,23 @@ KeySpec force_quadrature_key() {
           -inf, inf, false, false, {"centroid", "domain"}};
 }
 
+KeySpec body_force_key(const std::string& closed_form) {
+  const double inf = std::numeric_limits<double>::infinity();
+  return {"body_force", KeyKind::text, std::string("closed-form"),
+          "closed-form: " + closed_form + " (neo-hookean only; equal to the derived force to round-off); derived: "
+          "automatic differentiation of the motion and material",
+          -inf, inf, false, false, {"closed-form", "derived"}};
+}
+
+bool closed_form_force(const Config& c, const MaterialModel& material, const std::string& closed_form) {
+  if (c.text("body_force") != "closed-form") return false;
+  if (!std::holds_alternative<NeoHookean>(material))
+    c.reject("body_force", fmt::format("the closed form ({}) holds for the neo-Hookean solid only; material = \"{}\" "
+                                       "(from {}) needs body_force = \"derived\"",
+                                       closed_form, c.text("material"), c.origin("material").source));
+  return true;
+}
+
 std::vector<KeySpec> problem_keys(std::vector<KeySpec> k, const std::vector<KeySpec>& own,
                                   const std::vector<KeySpec>& material) {
   k.insert(k.end(), own.begin(), own.end());

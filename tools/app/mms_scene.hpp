@@ -136,6 +136,14 @@ KeySpec seeding_key();
 // samples it (mms/force_field.hpp), "centroid" by default.
 KeySpec force_quadrature_key();
 
+// The key of a problem whose body force has a closed form beside the derived
+// one (`closed_form` says which): "closed-form" by default, for the
+// neo-Hookean solid only.
+KeySpec body_force_key(const std::string& closed_form);
+// Whether the closed form is asked for; rejects it for another material,
+// naming where the material came from (throws ConfigError).
+bool closed_form_force(const Config& config, const MaterialModel& material, const std::string& closed_form);
+
 // A problem's keys: the solver's, its own, the seeding key and the material's.
 std::vector<KeySpec> problem_keys(std::vector<KeySpec> solver, const std::vector<KeySpec>& own,
                                   const std::vector<KeySpec>& material);

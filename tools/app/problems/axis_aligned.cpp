@@ -13,11 +13,14 @@ namespace mpmvv::app {
 
 namespace {
 
+constexpr const char* kClosedForm = "mms/axis_aligned.hpp";
+
 std::vector<KeySpec> keys() {
   const double inf = std::numeric_limits<double>::infinity();
   std::vector<KeySpec> k = solver_keys(32, 0.02, {0.005, 0.01, 0.015, 0.02});
   const std::vector<KeySpec> own = {
       force_quadrature_key(),
+      body_force_key(kClosedForm),
       {"variant", KeyKind::text, std::string("2d"),
        "2d: the unit square; 1d: u = A sin(2 pi X / L) cos(c pi t / L) on a strip in uniaxial strain", -inf, inf,
        false, false, {"2d", "1d"}},
@@ -58,6 +61,9 @@ ProblemSetup setup(const Config& c) {
   if (!(motion.amplitude < 0.25 * L))
     c.reject("amplitude", fmt::format("must stay below L / 4 = {} so that the square keeps its shape", 0.25 * L));
   s.solution = mms::make_solution(motion, s.material, c.real("density"), s.geometry);
+  if (closed_form_force(c, s.material, kClosedForm))
+    s.fast_body_force = std::make_shared<mms::AxisAlignedClosedFormField>(motion, std::get<NeoHookean>(s.material),
+                                                                          c.real("density"));
 
   const int cells = int(c.integer("cells"));
   // The strip is two cells high, walls above and below. The body's extent is

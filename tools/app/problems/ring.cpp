@@ -16,6 +16,8 @@ namespace {
 
 using std::numbers::pi;
 
+constexpr const char* kClosedForm = "eqs. 2.14-2.15";
+
 std::vector<KeySpec> keys() {
   const double inf = std::numeric_limits<double>::infinity();
   std::vector<KeySpec> k = solver_keys(64, 1.0, {0.1, 0.2, 0.25, 0.3, 0.4, 0.5, 0.6, 0.7, 0.75, 0.8, 0.9, 1.0});
@@ -38,10 +40,7 @@ std::vector<KeySpec> keys() {
        "outside the ring (for B-splines, whose node values are not the field's values)",
        -inf, inf, false, false, {"free", "held", "rest"}},
       force_quadrature_key(),
-      {"body_force", KeyKind::text, std::string("closed-form"),
-       "closed-form: eqs. 2.14-2.15 (neo-hookean only; equal to the derived force to round-off); derived: "
-       "automatic differentiation of the motion and material",
-       -inf, inf, false, false, {"closed-form", "derived"}},
+      body_force_key(kClosedForm),
   };
   return problem_keys(std::move(k), ring, material_keys("neo-hookean", 577.0, 385.0, 1000.0));
 }
@@ -141,13 +140,8 @@ ProblemSetup setup(const Config& c) {
                      : "grid nodes outside the ring held at rest";
   }
   // Eqs. 2.14-2.15 belong to the neo-Hookean solid; other materials use the derived force.
-  if (c.text("body_force") == "closed-form") {
-    if (!std::holds_alternative<NeoHookean>(s.material))
-      c.reject("body_force", fmt::format("the closed form (eqs. 2.14-2.15) holds for the neo-Hookean solid only; "
-                                         "material = \"{}\" (from {}) needs body_force = \"derived\"",
-                                         c.text("material"), c.origin("material").source));
+  if (closed_form_force(c, s.material, kClosedForm))
     s.fast_body_force = std::make_shared<mms::RingClosedFormField>(mms::RingMms(p));
-  }
   return s;
 }
 
