@@ -560,6 +560,33 @@ TEST(RingClosedForm, DerivedForceEqualsEquations2_14To2_15) {
   }
 }
 
+// A closed-form force field against the derived one for the same motion and
+// material, prepared at points X: at each time, the largest |b_closed -
+// b_derived| is below 1e-12 of the largest |b_derived| (and that is not
+// zero). Returns the largest ratio over the times, for the test's record.
+double closed_form_against_derived(mpmvv::mms::ForceField& closed, const std::shared_ptr<const ExactSolution>& solution,
+                                   const std::vector<Vec2>& X, const std::vector<double>& times,
+                                   const std::string& label) {
+  closed.prepare(X);
+  mpmvv::mms::DerivedForceField derived(solution);
+  derived.prepare(X);
+  double worst_relative = 0.0;
+  for (double t : times) {
+    std::vector<Vec2> b_closed(X.size()), b_derived(X.size());
+    closed.evaluate(t, b_closed);
+    derived.evaluate(t, b_derived);
+    double largest = 0.0, worst = 0.0;
+    for (std::size_t k = 0; k < X.size(); ++k) {
+      largest = std::max(largest, b_derived[k].norm());
+      worst = std::max(worst, (b_closed[k] - b_derived[k]).norm());
+    }
+    EXPECT_GT(largest, 0.0) << label << ", t = " << t;
+    EXPECT_LT(worst, 1e-12 * largest) << label << ", t = " << t;
+    worst_relative = std::max(worst_relative, worst / largest);
+  }
+  return worst_relative;
+}
+
 // The closed form as a force field (RingClosedFormField, after prepare())
 // fills the same vectors as the derived field (DerivedForceField) for a set of
 // points at several times: the largest difference is below 1e-12 of the
@@ -570,27 +597,13 @@ TEST(RingClosedForm, ClosedFormFieldEqualsDerivedField) {
     std::vector<Vec2> X;
     for (const Sample& s : ring_samples(500, 23)) X.push_back(s.X);
     mpmvv::mms::RingClosedFormField closed{RingMms(p)};
-    closed.prepare(X);
-    mpmvv::mms::DerivedForceField derived(
-        mpmvv::mms::make_solution(RingMotion{p}, NeoHookean{p.lambda, p.mu}, p.density, Geometry::plane_strain));
-    derived.prepare(X);
-    double worst_relative = 0.0;
-    for (double t : {0.0, 0.13, 0.5, 0.77, 1.0}) {
-      std::vector<Vec2> b_closed(X.size()), b_derived(X.size());
-      closed.evaluate(t, b_closed);
-      derived.evaluate(t, b_derived);
-      double largest = 0.0, worst = 0.0;
-      for (std::size_t k = 0; k < X.size(); ++k) {
-        largest = std::max(largest, b_closed[k].norm());
-        worst = std::max(worst, (b_closed[k] - b_derived[k]).norm());
-      }
-      EXPECT_GT(largest, 0.0);
-      EXPECT_LT(worst, 1e-12 * largest) << "t = " << t;
-      worst_relative = std::max(worst_relative, worst / largest);
-    }
-    RecordProperty(std::string(c.time_function == RingTimeFunction::cosine ? "cosine" : "sine") + "_A" +
-                       std::to_string(c.amplitude),
-                   scientific(worst_relative));
+    const std::string label = std::string(c.time_function == RingTimeFunction::cosine ? "cosine" : "sine") + "_A" +
+                              std::to_string(c.amplitude);
+    RecordProperty(label, scientific(closed_form_against_derived(
+                              closed,
+                              mpmvv::mms::make_solution(RingMotion{p}, NeoHookean{p.lambda, p.mu}, p.density,
+                                                        Geometry::plane_strain),
+                              X, {0.0, 0.13, 0.5, 0.77, 1.0}, label)));
   }
 }
 
@@ -611,24 +624,54 @@ TEST(AxisAlignedClosedForm, ClosedFormFieldEqualsDerivedField) {
       std::vector<Vec2> X(400);
       for (Vec2& x : X) x = Vec2(unit(rng), one_d ? 0.05 * unit(rng) : unit(rng));
       mpmvv::mms::AxisAlignedClosedFormField closed(motion, material, 1.0);
-      closed.prepare(X);
-      mpmvv::mms::DerivedForceField derived(mpmvv::mms::make_solution(motion, material, 1.0, Geometry::plane_strain));
-      derived.prepare(X);
-      double worst_relative = 0.0;
-      for (double t : {0.0, 0.0013, 0.004, 0.0071, 0.02}) {
-        std::vector<Vec2> b_closed(X.size()), b_derived(X.size());
-        closed.evaluate(t, b_closed);
-        derived.evaluate(t, b_derived);
-        double largest = 0.0, worst = 0.0;
-        for (std::size_t k = 0; k < X.size(); ++k) {
-          largest = std::max(largest, b_derived[k].norm());
-          worst = std::max(worst, (b_closed[k] - b_derived[k]).norm());
-        }
-        ASSERT_GT(largest, 0.0);
-        EXPECT_LT(worst, 1e-12 * largest) << (one_d ? "1d" : "2d") << ", A = " << amplitude << ", t = " << t;
-        worst_relative = std::max(worst_relative, worst / largest);
+      const std::string label = std::string(one_d ? "1d" : "2d") + "_A" + std::to_string(amplitude);
+      RecordProperty(label, scientific(closed_form_against_derived(
+                                closed, mpmvv::mms::make_solution(motion, material, 1.0, Geometry::plane_strain), X,
+                                {0.0, 0.0013, 0.004, 0.0071, 0.02}, label)));
+    }
+}
+
+// The pulsating cylinder's closed-form force (RzCylinderClosedFormField)
+// fills the same vectors as the derived field in r-z, hollow and solid, at
+// several times: the largest difference is below 1e-12 of the largest force.
+TEST(RzCylinderClosedForm, ClosedFormFieldEqualsDerivedField) {
+  const NeoHookean material{577.0, 385.0};
+  for (const double inner : {0.25, 0.0})
+    for (const double amplitude : {0.2, 0.4}) {
+      const mpmvv::mms::RzCylinderMotion motion{inner, 1.0, 1.0, amplitude, 1.0};
+      std::mt19937 rng(37);
+      std::uniform_real_distribution<double> radius(std::max(inner, 0.01), 1.0), height(0.0, 1.0);
+      std::vector<Vec2> X(400);
+      for (Vec2& x : X) x = Vec2(radius(rng), height(rng));
+      mpmvv::mms::RzCylinderClosedFormField closed(motion, material, 1000.0);
+      const std::string label = std::string(inner > 0.0 ? "hollow" : "solid") + "_A" + std::to_string(amplitude);
+      RecordProperty(label, scientific(closed_form_against_derived(
+                                closed, mpmvv::mms::make_solution(motion, material, 1000.0, Geometry::axisymmetric), X,
+                                {0.0, 0.13, 0.25, 0.5, 0.81}, label)));
+    }
+}
+
+// The expanding ring's closed-form force (ExpandingRingClosedFormField)
+// fills the same vectors as the derived field, for both profiles, with the
+// problem's material (nu = 0) and with lambda > 0, at several times: the
+// largest difference is below 1e-12 of the largest force.
+TEST(ExpandingRingClosedForm, ClosedFormFieldEqualsDerivedField) {
+  for (const NeoHookean material : {NeoHookean{0.0, 5e6}, NeoHookean{7.5e6, 5e6}})
+    for (const bool bubble : {false, true}) {
+      const mpmvv::mms::ExpandingRingMotion motion{0.4, 0.6, 0.1, 100.0, bubble};
+      std::mt19937 rng(41);
+      std::uniform_real_distribution<double> radius(0.4, 0.6), angle(0.0, 2.0 * pi);
+      std::vector<Vec2> X(400);
+      for (Vec2& x : X) {
+        const double R = radius(rng), a = angle(rng);
+        x = R * Vec2(std::cos(a), std::sin(a));
       }
-      RecordProperty(std::string(one_d ? "1d" : "2d") + "_A" + std::to_string(amplitude), scientific(worst_relative));
+      mpmvv::mms::ExpandingRingClosedFormField closed(motion, material, 1000.0);
+      const std::string label =
+          std::string(bubble ? "bubble" : "uintah") + "_lambda" + std::to_string(int(material.lambda));
+      RecordProperty(label, scientific(closed_form_against_derived(
+                                closed, mpmvv::mms::make_solution(motion, material, 1000.0, Geometry::plane_strain), X,
+                                {0.001, 0.0023, 0.005, 0.0091}, label)));
     }
 }
 

@@ -74,11 +74,13 @@ int main(int argc, char** argv) {
       {"ring, mooney-rivlin (derived)", "ring", {"body_force=derived", "material=mooney-rivlin"}},
       {"axis-aligned 2d (derived)", "axis-aligned", {"body_force=derived"}},
       {"axis-aligned 1d (derived)", "axis-aligned", {"body_force=derived", "variant=1d"}},
-      {"expanding-ring (derived)", "expanding-ring", {}},
-      {"rz-cylinder (derived)", "rz-cylinder", {}},
+      {"expanding-ring (derived)", "expanding-ring", {"body_force=derived"}},
+      {"rz-cylinder (derived)", "rz-cylinder", {"body_force=derived"}},
       {"ring (closed form, eqs. 2.14-2.15)", "ring", {}, true},
       {"axis-aligned 2d (closed form)", "axis-aligned", {}, true},
       {"axis-aligned 1d (closed form)", "axis-aligned", {"variant=1d"}, true},
+      {"expanding-ring (closed form)", "expanding-ring", {}, true},
+      {"rz-cylinder (closed form)", "rz-cylinder", {}, true},
   };
   for (const Variant& v : variants) {
     const mpmvv::app::MmsProblem& problem = *mpmvv::app::find_mms_problem(v.problem);

@@ -14,6 +14,8 @@ namespace mpmvv::app {
 
 namespace {
 
+constexpr const char* kClosedForm = "mms/expanding_ring.hpp";
+
 using std::numbers::pi;
 
 std::vector<KeySpec> keys() {
@@ -21,6 +23,7 @@ std::vector<KeySpec> keys() {
   std::vector<KeySpec> k = solver_keys(64, 0.02, {0.005, 0.01, 0.015, 0.02});
   const std::vector<KeySpec> own = {
       force_quadrature_key(),
+      body_force_key(kClosedForm),
       {"amplitude", KeyKind::real, 0.1, "A of u = A sin(C pi t / (2 r_b)) (c1 + c2 R + c3 R^2) X", 0.0, 1.0, true},
       {"inner_radius", KeyKind::real, 0.4, "r_i [m]", 0.0, inf, true},
       {"outer_radius", KeyKind::real, 0.6, "r_o [m]", 0.0, inf, true},
@@ -56,6 +59,9 @@ ProblemSetup setup(const Config& c) {
   const mms::ExpandingRingMotion motion{ri, ro, c.real("amplitude"), std::sqrt(E / c.real("density")),
                                        c.text("profile") == "bubble"};
   s.solution = mms::make_solution(motion, s.material, c.real("density"), s.geometry);
+  if (closed_form_force(c, s.material, kClosedForm))
+    s.fast_body_force = std::make_shared<mms::ExpandingRingClosedFormField>(motion, std::get<NeoHookean>(s.material),
+                                                                            c.real("density"));
 
   const double domain = c.real("domain");
   const int cells = int(c.integer("cells"));

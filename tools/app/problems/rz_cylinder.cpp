@@ -14,11 +14,14 @@ namespace mpmvv::app {
 
 namespace {
 
+constexpr const char* kClosedForm = "mms/rz_cylinder.hpp";
+
 std::vector<KeySpec> keys() {
   const double inf = std::numeric_limits<double>::infinity();
   std::vector<KeySpec> k = solver_keys(32, 1.0, {0.25, 0.5, 0.75, 1.0});
   const std::vector<KeySpec> own = {
       force_quadrature_key(),
+      body_force_key(kClosedForm),
       {"amplitude", KeyKind::real, 0.2, "A: the largest of g(t) = (A/2)(1 - cos 2 pi t / T)", 0.0, 1.0, true},
       {"inner_radius", KeyKind::real, 0.25, "R_i [m]; 0 for a solid cylinder with particles up to the axis", 0.0, inf},
       {"outer_radius", KeyKind::real, 1.0, "R_o [m]", 0.0, inf, true},
@@ -39,6 +42,9 @@ ProblemSetup setup(const Config& c) {
   if (!(ro > ri))
     c.reject("outer_radius", fmt::format("must exceed inner_radius = {} (from {})", ri, c.origin("inner_radius").source));
   s.solution = mms::make_solution(motion, s.material, c.real("density"), s.geometry);
+  if (closed_form_force(c, s.material, kClosedForm))
+    s.fast_body_force = std::make_shared<mms::RzCylinderClosedFormField>(motion, std::get<NeoHookean>(s.material),
+                                                                         c.real("density"));
 
   const int cells = int(c.integer("cells"));
   const double h = H / cells;  // cells along the height
