@@ -20,6 +20,7 @@
 #include <cmath>
 #include <cstddef>
 #include <memory>
+#include <numeric>
 #include <stdexcept>
 #include <vector>
 
@@ -40,10 +41,13 @@ class ForceField {
   // b at every point [m/s^2].
   virtual void evaluate(double t, std::vector<Vec2>& b) const = 0;
   // All points placed anew.
-  void prepare(const std::vector<Vec2>& points) {
-    std::vector<std::size_t> index(points.size());
-    for (std::size_t k = 0; k < index.size(); ++k) index[k] = k;
-    place(points.size(), index, points);
+  void prepare(const std::vector<Vec2>& points) { place(points.size(), all_indices(points.size()), points); }
+
+  // 0, 1, ..., n - 1.
+  static std::vector<std::size_t> all_indices(std::size_t n) {
+    std::vector<std::size_t> index(n);
+    std::iota(index.begin(), index.end(), std::size_t{0});
+    return index;
   }
 };
 
@@ -93,11 +97,7 @@ class ManufacturedBodyForce final : public BodyForce {
 
   ForceQuadrature quadrature() const { return quadrature_; }
 
-  void prepare(const Particles& P) override {
-    std::vector<std::size_t> all(P.size());
-    for (std::size_t p = 0; p < all.size(); ++p) all[p] = p;
-    place_particles(P, all);
-  }
+  void prepare(const Particles& P) override { place_particles(P, ForceField::all_indices(P.size())); }
 
   // Only the particles a split changed or appended are placed again: the
   // others' points, and what the field keeps for them, still hold.

@@ -264,14 +264,14 @@ struct CpdiExactShapeT {
       if (!(y_lo >= j0 + cj)) n = clip_polygon(row, n, 1, j0 + cj, true, row_a, kClipBuffer), row = row_a;
       if (!(y_hi <= j0 + cj + 1)) n = clip_polygon(row, n, 1, j0 + cj + 1, false, row_b, kClipBuffer), row = row_b;
       if (n < 3) continue;
-      double row_lo = row[0].x(), row_hi = row[0].x();
-      for (int k = 1; k < n; ++k) row_lo = std::min(row_lo, row[k].x()), row_hi = std::max(row_hi, row[k].x());
+      Vec2 row_lo, row_hi;
+      bounds(row, n, row_lo, row_hi);
       for (int ci = 0; ci < block - 1 && i0 + ci < g.cells_x; ++ci) {
         if (i0 + ci >= hi.x()) break;
         const Vec2* cell = row;
         int m = n;
-        if (!(row_lo >= i0 + ci)) m = clip_polygon(cell, m, 0, i0 + ci, true, a, kClipBuffer), cell = a;
-        if (!(row_hi <= i0 + ci + 1)) m = clip_polygon(cell, m, 0, i0 + ci + 1, false, piece, kClipBuffer), cell = piece;
+        if (!(row_lo.x() >= i0 + ci)) m = clip_polygon(cell, m, 0, i0 + ci, true, a, kClipBuffer), cell = a;
+        if (!(row_hi.x() <= i0 + ci + 1)) m = clip_polygon(cell, m, 0, i0 + ci + 1, false, piece, kClipBuffer), cell = piece;
         if (m < 3) continue;
         last_ci = std::max(last_ci, ci);
         last_cj = std::max(last_cj, cj);

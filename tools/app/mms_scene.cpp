@@ -62,13 +62,14 @@ KeySpec body_force_key(const std::string& closed_form) {
           -inf, inf, false, false, {"closed-form", "derived"}};
 }
 
-bool closed_form_force(const Config& c, const MaterialModel& material, const std::string& closed_form) {
-  if (c.text("body_force") != "closed-form") return false;
-  if (!std::holds_alternative<NeoHookean>(material))
+const NeoHookean* closed_form_force(const Config& c, const MaterialModel& material, const std::string& closed_form) {
+  if (c.text("body_force") != "closed-form") return nullptr;
+  const NeoHookean* solid = std::get_if<NeoHookean>(&material);
+  if (!solid)
     c.reject("body_force", fmt::format("the closed form ({}) holds for the neo-Hookean solid only; material = \"{}\" "
                                        "(from {}) needs body_force = \"derived\"",
                                        closed_form, c.text("material"), c.origin("material").source));
-  return true;
+  return solid;
 }
 
 std::vector<KeySpec> problem_keys(std::vector<KeySpec> k, const std::vector<KeySpec>& own,

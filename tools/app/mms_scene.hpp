@@ -140,9 +140,10 @@ KeySpec force_quadrature_key();
 // one (`closed_form` says which): "closed-form" by default, for the
 // neo-Hookean solid only.
 KeySpec body_force_key(const std::string& closed_form);
-// Whether the closed form is asked for; rejects it for another material,
-// naming where the material came from (throws ConfigError).
-bool closed_form_force(const Config& config, const MaterialModel& material, const std::string& closed_form);
+// The neo-Hookean solid the closed form is written for when it is asked for,
+// else null; rejects it for another material, naming where the material came
+// from (throws ConfigError).
+const NeoHookean* closed_form_force(const Config& config, const MaterialModel& material, const std::string& closed_form);
 
 // A problem's keys: the solver's, its own, the seeding key and the material's.
 std::vector<KeySpec> problem_keys(std::vector<KeySpec> solver, const std::vector<KeySpec>& own,

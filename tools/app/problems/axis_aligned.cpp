@@ -61,9 +61,8 @@ ProblemSetup setup(const Config& c) {
   if (!(motion.amplitude < 0.25 * L))
     c.reject("amplitude", fmt::format("must stay below L / 4 = {} so that the square keeps its shape", 0.25 * L));
   s.solution = mms::make_solution(motion, s.material, c.real("density"), s.geometry);
-  if (closed_form_force(c, s.material, kClosedForm))
-    s.fast_body_force = std::make_shared<mms::AxisAlignedClosedFormField>(motion, std::get<NeoHookean>(s.material),
-                                                                          c.real("density"));
+  if (const NeoHookean* solid = closed_form_force(c, s.material, kClosedForm))
+    s.fast_body_force = std::make_shared<mms::AxisAlignedClosedFormField>(motion, *solid, c.real("density"));
 
   const int cells = int(c.integer("cells"));
   // The strip is two cells high, walls above and below. The body's extent is

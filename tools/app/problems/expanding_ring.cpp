@@ -59,9 +59,8 @@ ProblemSetup setup(const Config& c) {
   const mms::ExpandingRingMotion motion{ri, ro, c.real("amplitude"), std::sqrt(E / c.real("density")),
                                        c.text("profile") == "bubble"};
   s.solution = mms::make_solution(motion, s.material, c.real("density"), s.geometry);
-  if (closed_form_force(c, s.material, kClosedForm))
-    s.fast_body_force = std::make_shared<mms::ExpandingRingClosedFormField>(motion, std::get<NeoHookean>(s.material),
-                                                                            c.real("density"));
+  if (const NeoHookean* solid = closed_form_force(c, s.material, kClosedForm))
+    s.fast_body_force = std::make_shared<mms::ExpandingRingClosedFormField>(motion, *solid, c.real("density"));
 
   const double domain = c.real("domain");
   const int cells = int(c.integer("cells"));

@@ -42,9 +42,8 @@ ProblemSetup setup(const Config& c) {
   if (!(ro > ri))
     c.reject("outer_radius", fmt::format("must exceed inner_radius = {} (from {})", ri, c.origin("inner_radius").source));
   s.solution = mms::make_solution(motion, s.material, c.real("density"), s.geometry);
-  if (closed_form_force(c, s.material, kClosedForm))
-    s.fast_body_force = std::make_shared<mms::RzCylinderClosedFormField>(motion, std::get<NeoHookean>(s.material),
-                                                                         c.real("density"));
+  if (const NeoHookean* solid = closed_form_force(c, s.material, kClosedForm))
+    s.fast_body_force = std::make_shared<mms::RzCylinderClosedFormField>(motion, *solid, c.real("density"));
 
   const int cells = int(c.integer("cells"));
   const double h = H / cells;  // cells along the height
