@@ -198,6 +198,32 @@ TEST(NeoHookean, WaveModulusIsPWaveModulusAtRestAndGrowsUnderShear) {
   }
 }
 
+// The scan's early test (stages.hpp: signal_speed) leaves out a particle only
+// below wave_modulus_bound: it must never be below the wave modulus, in
+// compression and tension, with and without an out-of-plane stretch, and for
+// a negative lambda (the bound takes |mu - lambda x| at both ends).
+TEST(NeoHookean, WaveModulusBoundIsAtLeastTheWaveModulus) {
+  std::mt19937 rng(41);
+  std::uniform_real_distribution<double> stretch(0.3, 3.0);
+  for (const mpmvv::NeoHookean& m : {kNeoHookean, mpmvv::NeoHookean{576923.0769230769, 384615.3846153846},
+                                     mpmvv::NeoHookean{-100.0, 400.0}}) {
+    double tightest = 1e300;
+    for (int k = 0; k < 2000; ++k) {
+      const Mat2 F = mpmvv::testing::random_deformation(rng, 1.5, 0.1);
+      const double F33 = k % 2 ? 1.0 : stretch(rng);
+      if (!(mpmvv::determinant(F) * F33 > 0.0)) continue;
+      const Mat2 sigma = m.stress(F, F33).in_plane;
+      const double exact = m.wave_modulus(F, F33, sigma), bound = m.wave_modulus_bound(F, F33, sigma);
+      ASSERT_GE(bound, exact) << "F = " << show(F) << ", F33 = " << F33 << ", lambda = " << m.lambda;
+      tightest = std::min(tightest, bound / exact);
+    }
+    // The bound is tight where J = 1 and the stress has no shear, as at rest.
+    EXPECT_DOUBLE_EQ(m.wave_modulus_bound(Mat2::Identity(), 1.0, Mat2::Zero()),
+                     m.wave_modulus(Mat2::Identity(), 1.0, Mat2::Zero()));
+    EXPECT_LT(tightest, 1.01);
+  }
+}
+
 // ---------------------------------------------------------------- Mooney-Rivlin
 
 // At small shear sigma_xy / gamma tends to the shear modulus 2 (c1 + c2), with

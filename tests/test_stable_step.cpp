@@ -389,3 +389,78 @@ TEST(StableStep, GradientSumBoundHoldsForRandomDomains) {
     EXPECT_LE(mpmvv::gradient_sum(axisymmetric, p), axisymmetric.gradient_sum_bound(p) * (1.0 + 1e-12));
   }
 }
+
+namespace {
+
+// The neo-Hookean solid without its wave_modulus_bound: the scan then forms
+// every particle's speed in full.
+struct WithoutBound {
+  NeoHookean solid;
+  double wave_modulus(const Mat2& F, double F33, const Mat2& sigma) const { return solid.wave_modulus(F, F33, sigma); }
+  double p_wave_modulus() const { return solid.p_wave_modulus(); }
+};
+
+// A "bound" that is not one: the scan would leave out the particles that set
+// the largest speed, which the comparison below must see.
+struct BelowTheWaveModulus : WithoutBound {
+  double wave_modulus_bound(const Mat2& F, double F33, const Mat2& sigma) const {
+    return 0.25 * solid.wave_modulus(F, F33, sigma);
+  }
+};
+
+}  // namespace
+
+// The scan leaves out a particle whose bound cannot beat the largest speed so
+// far (stages.hpp: signal_speed); the largest speed is then the one that
+// forming every particle's speed gives, bit for bit, from the particle's
+// state alone (scan_particles) and with the map's stencils (ScanInMap), over
+// sheared, stretched and compressed CPDI domains, some at rest and some fast.
+TEST(StableStep, TheScansEarlyTestLeavesTheLargestSpeedAsItIs) {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> where(4.0, 12.0), unit(-1.0, 1.0);
+  for (const NeoHookean& solid : {kSolid, NeoHookean{576923.0769230769, 384615.3846153846}}) {
+    Model model;
+    model.grid = GridGeometry::walled(Vec2::Zero(), 1.0, 16, 16);
+    Particles& P = model.particles;
+    P.resize(3000);
+    P.half_size.assign(P.size(), Vec2(0.25, 0.25));
+    const double c0 = std::sqrt(solid.p_wave_modulus() / kDensity);
+    for (std::size_t p = 0; p < P.size(); ++p) {
+      P.position[p] = Vec2(where(rng), where(rng));
+      const double shear = p % 3 == 0 ? 0.0 : 0.4 * where(rng) - 1.6;
+      P.deformation_gradient[p] =
+          rotation(where(rng)) * simple_shear(shear) * mpmvv::testing::random_deformation(rng, 0.3, 0.4);
+      P.velocity[p] = (p % 5 == 0 ? 2.0 : 0.1) * c0 * Vec2(unit(rng), unit(rng));
+      P.reference_volume[p] = 0.25;
+      P.volume[p] = mpmvv::determinant(P.deformation_gradient[p]) * P.reference_volume[p];
+      P.mass[p] = kDensity * P.reference_volume[p];
+      P.stress[p] = solid.cauchy_stress(P.deformation_gradient[p]);
+    }
+    const CpdiShape shape = CpdiShape::bind(model.grid, P);
+    const mpmvv::ParticleScan bounded = mpmvv::scan_particles(shape, solid, P, model.grid.h);
+    const mpmvv::ParticleScan full = mpmvv::scan_particles(shape, WithoutBound{solid}, P, model.grid.h);
+    ASSERT_EQ(bounded.first_unhealthy, P.size());
+    EXPECT_EQ(bounded.max_signal_speed, full.max_signal_speed);
+    EXPECT_GT(full.max_signal_speed, c0);
+
+    mpmvv::ScatterBuffers buffers;
+    buffers.resize(mpmvv::max_threads(), model.grid.node_count());
+    mpmvv::GridFields g;
+    g.resize(model.grid.node_count());
+    mpmvv::ScanInMap<CpdiShape, NeoHookean> in_map{shape, solid, P, model.grid.h};
+    mpmvv::particles_to_grid<mpmvv::kMass>(shape, P, buffers, g, {}, nullptr, &in_map);
+    const WithoutBound unbounded{solid};
+    mpmvv::ScanInMap<CpdiShape, WithoutBound> in_map_full{shape, unbounded, P, model.grid.h};
+    mpmvv::particles_to_grid<mpmvv::kMass>(shape, P, buffers, g, {}, nullptr, &in_map_full);
+    EXPECT_EQ(in_map.result.max_signal_speed, in_map_full.result.max_signal_speed);
+    EXPECT_EQ(in_map.result.max_signal_speed, full.max_signal_speed);
+
+    // uGIMP has no stiffening: the material's wave speed alone sets the
+    // largest, and a bound below it would change it.
+    const mpmvv::GimpShape gimp = mpmvv::GimpShape::bind(model.grid, P);
+    const double gimp_full = mpmvv::scan_particles(gimp, unbounded, P, model.grid.h).max_signal_speed;
+    EXPECT_EQ(mpmvv::scan_particles(gimp, solid, P, model.grid.h).max_signal_speed, gimp_full);
+    EXPECT_LT(mpmvv::scan_particles(gimp, BelowTheWaveModulus{unbounded}, P, model.grid.h).max_signal_speed,
+              gimp_full);
+  }
+}

@@ -61,6 +61,18 @@ struct NeoHookean {
            std::max(largest_principal(sigma), 0.0);
   }
   double wave_modulus(const Mat2& F, const Mat2& sigma) const { return wave_modulus(F, 1.0, sigma); }
+
+  // An upper bound of wave_modulus without its logarithm and square root, for
+  // the time-step scan's early test (stages.hpp: signal_speed): ln J lies in
+  // [1 - 1/J, J - 1], and |mu - lambda x| is largest at an end of it; the
+  // largest principal stress mean + sqrt(d^2 + s_xy^2) is at most
+  // max(s_xx, s_yy) + |s_xy|.
+  double wave_modulus_bound(const Mat2& F, double F33, const Mat2& sigma) const {
+    const double J = determinant(F) * F33;
+    const double shear = std::max(std::abs(mu - lambda * (J - 1.0)), std::abs(mu - lambda * (1.0 - 1.0 / J)));
+    return (std::abs(lambda) + 2.0 * shear) / J +
+           std::max(std::max(sigma(0, 0), sigma(1, 1)) + std::abs(sigma(0, 1)), 0.0);
+  }
 };
 
 }  // namespace mpmvv
