@@ -47,7 +47,7 @@ def main(paths):
     cases = sorted((read_case(p) for p in paths), key=lambda c: -c["h"])
     print(f"{'cells':>6} {'h [m]':>9} {'method':>7} {'status':>10} {'reached':>8} {'wall [s]':>9}")
     for c in cases:
-        status = c["status"] if c["status"] == "completed" else f"failed ({c['failure_reason']})"
+        status = c["status"] if c["status"] == "completed" else f"{c['status']} ({c['failure_reason']})"
         print(f"{c['cells']:>6} {c['h']:>9.4g} {c['method']:>7} {status:>10} {c['time_reached']:>8.4g} {c['wall']:>9.3g}")
     times = cases[0]["time"]
     for norm in cases[0]["norms"]:

@@ -14,8 +14,13 @@ expectation holds for a series when
 * max over the levels of E / h^order <= max_error_constant (when given);
 * every usable level's E <= max_error (when given; an expectation gives an
   order with its tolerance, or max_error, or both);
-* every level's case completed (when must_complete, the default);
-* at least two levels are usable (have a finite error at that time).
+* every level's case completed (when must_complete, the default), that is
+  neither failed nor lost its solution (the results file's health verdict);
+* at least two levels are usable (have a finite error at that time, and not
+  from the time a lost run's solution was lost on);
+* the fit's 95 % confidence interval lies within the band (when
+  interval_within_band; it needs three or more levels). Without it, an
+  interval that reaches outside the band is noted beside a PASS.
 
 Prints one row per (expectation, series) and a closing line; exit 0 when every
 expectation holds, 1 when one falls short, 2 (one line) when DIR is not a
@@ -37,6 +42,7 @@ EXPECT_KEYS = {
     "study": (str,), "norm": (str,), "order": NUMBER, "tolerance": NUMBER,
     "where": (dict,), "time": NUMBER, "refine": (str,), "levels": (list,),
     "max_error_constant": NUMBER, "max_error": NUMBER, "must_complete": (bool,),
+    "interval_within_band": (bool,),
 }
 REQUIRED_KEYS = ("study", "norm")
 
@@ -85,8 +91,9 @@ def validate_expectations(suite):
                 raise SuiteDirectoryError(f"{where}: [[expect]] {number}: 'tolerance' must be >= 0")
         if "max_error" in expect and not expect["max_error"] > 0:
             raise SuiteDirectoryError(f"{where}: [[expect]] {number}: 'max_error' must be positive")
-        if "max_error_constant" in expect and "order" not in expect:
-            raise SuiteDirectoryError(f"{where}: [[expect]] {number}: 'max_error_constant' needs an 'order'")
+        for key in ("max_error_constant", "interval_within_band"):
+            if key in expect and "order" not in expect:
+                raise SuiteDirectoryError(f"{where}: [[expect]] {number}: '{key}' needs an 'order'")
 
 
 def check_expectation(number, expect, suite):
@@ -141,11 +148,22 @@ def check_series(number, expect, series):
             reasons.append("cell size h does not vary over the usable levels: no order")
     elif not order - tolerance <= fit.order <= order + tolerance:
         reasons.append(f"order {fit.order:.3f} outside [{order - tolerance:g}, {order + tolerance:g}]")
+    interval_notes = []
+    if has_order and math.isfinite(fit.order):
+        band = f"[{order - tolerance:g}, {order + tolerance:g}]"
+        inside = order - tolerance <= fit.ci_low and fit.ci_high <= order + tolerance
+        if expect.get("interval_within_band", False):
+            if not math.isfinite(fit.ci_low):
+                reasons.append(f"{len(good)} usable levels give no confidence interval; interval_within_band needs 3")
+            elif not inside:
+                reasons.append(f"95% interval [{fit.ci_low:.2f}, {fit.ci_high:.2f}] not within {band}")
+        elif math.isfinite(fit.ci_low) and not inside:
+            interval_notes.append(f"its 95% interval [{fit.ci_low:.2f}, {fit.ci_high:.2f}] reaches outside {band}")
     limit = expect.get("max_error_constant")
     if limit is not None and math.isfinite(constant) and constant > limit:
         reasons.append(f"E/h^{order:g} = {constant:.3g} > {limit:g}")
     if len(good) >= (2 if has_order else 1):
-        notes = [f"left out {series.refine}={l.value} ({l.reason})" for l in levels if l.reason]
+        notes = interval_notes + [f"left out {series.refine}={l.value} ({l.reason})" for l in levels if l.reason]
     return Verdict(number, expect, series, tuple(levels), fit, constant, tuple(reasons), tuple(notes))
 
 

@@ -307,6 +307,12 @@ def stability_cell(case):
     reached = case.time_reached
     if case.completed:
         return figures.StabilityCell(1.0, "done")
+    if case.status == "lost":
+        # It reached the end time, but its solution was gone from the health verdict's time on.
+        lost_at = float(case.attribute("health_time"))
+        fraction = lost_at / case.end_time if case.end_time > 0 else float("nan")
+        return figures.StabilityCell(min(max(fraction, 0.0), 1.0), f"{reached:.3g} s\nlost at\n{lost_at:.3g} s",
+                                     stopped=True)
     fraction = reached / case.end_time if case.end_time > 0 else float("nan")
     reason = textwrap.fill(case.failure_reason or case.status, 9)
     return figures.StabilityCell(min(max(fraction, 0.0), 1.0), f"{reached:.3g} s\n{reason}", stopped=True)
@@ -329,7 +335,8 @@ def stability_figure(study, all_series, directory):
     path = directory / f"{slug(study, 'stability')}.png"
     figures.save_png(figure, path)
     return FigureEntry(study, path, f"{study}: how far each case got (cf. table 3.2 of 000_1dbcb8acb6dddab9.txt): "
-                                    f"time reached and failure reason (done: reached the end time); hatched: stopped before the end time; "
+                                    f"time reached and failure reason (done: reached the end time); hatched: stopped before the end time, "
+                                    f"or lost its solution (the time it was lost shown and coloured); "
                                     f"grey: no results (status shown).")
 
 
@@ -945,7 +952,7 @@ table { border-collapse: collapse; font-size: 0.85em; margin: 0.5em 0 1.5em; }
 th, td { border: 1px solid #ccc; padding: 2px 6px; text-align: left; vertical-align: top; }
 th { background: #f0f0f0; position: sticky; top: 0; }
 tr.completed td:nth-child(2), tr.PASS td:nth-child(10), tr.asymptotic td:last-child { color: #1a7f37; }
-tr.failed td:nth-child(2), tr.crashed td:nth-child(2), tr.timeout td:nth-child(2), tr.error td:nth-child(2),
+tr.failed td:nth-child(2), tr.lost td:nth-child(2), tr.crashed td:nth-child(2), tr.timeout td:nth-child(2), tr.error td:nth-child(2),
 tr.FAIL td:nth-child(10), tr.stalled td:last-child { color: #c62828; font-weight: bold; }
 tr.pending td:nth-child(2), tr.non-asymptotic td:last-child { color: #9a6700; }
 figure { margin: 1em 0 2em; } figure img { max-width: 100%; border: 1px solid #eee; }

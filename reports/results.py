@@ -5,8 +5,10 @@ the results files in it (reports/results-format.md).
     DIR/suite.toml           the suite as run: [[study]], [[expect]] and [[reference]] tables
     DIR/cases/<id>.h5        one results file per case that ran
 
-A case's status is the manifest's (completed, failed, crashed, timeout, error,
-pending). A case without a readable results file (pending, crashed, timeout,
+A case's status is the manifest's (completed, lost, failed, crashed, timeout,
+error, pending); "lost" is a run that reached its end time with its solution
+lost (the results file's health verdict, reports/results-format.md), and it
+counts as not completed everywhere. A case without a readable results file (pending, crashed, timeout,
 error, or a damaged file) is kept with ``results = None`` and a note saying why,
 so that every report and the gate can show it instead of stopping on it.
 Only root attributes, /errors and the /measurements scalars are read up front;
@@ -24,7 +26,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-CASE_STATUSES = ("completed", "failed", "crashed", "timeout", "error", "pending")
+CASE_STATUSES = ("completed", "lost", "failed", "crashed", "timeout", "error", "pending")
 TIME_MATCH_TOLERANCE = 1e-9   # relative; output times are written from the same decimal values
 
 
@@ -73,6 +75,9 @@ class Case:
 
     @property
     def failure_reason(self):
+        if self.status == "lost":
+            return (f"solution lost at t = {float(self.attribute('health_time')):.4g} s: "
+                    f"{self.attribute('health_reason', '')}")
         reason = self.attribute("failure_reason", "")
         return reason or self.detail or self.note
 
@@ -178,6 +183,9 @@ def _read_case(directory, entry):
     status = entry.get("status")
     if status not in CASE_STATUSES:
         status = results.attributes.get("status", "pending") if results is not None else "pending"
+    # The results file's own verdict wins over a manifest that called the run completed.
+    if status == "completed" and results is not None and results.attributes.get("status") == "lost":
+        status = "lost"
     return Case(id=entry["id"], study=entry["study"], keys=dict(entry.get("keys", {})), status=status,
                 detail=str(entry.get("detail", "")), results_path=results_path,
                 manifest_wall_time_s=float(wall_time) if isinstance(wall_time, (int, float)) else float("nan"),
@@ -225,6 +233,12 @@ def lookup_error(case, norm, time):
     column = case.results.errors[norm]
     if hits.size == 0 or hits[0] >= column.size:
         return nan, f"no output at t = {time:g} (reached {case.time_reached:.4g})"
+    # From the output time at which the health verdict found the solution lost
+    # on, the run's errors measure no solution (the outputs before stay usable,
+    # as a failed run's do).
+    lost_at = float(case.attribute("health_time"))
+    if case.attribute("health", "") == "solution lost" and time >= lost_at * (1.0 - TIME_MATCH_TOLERANCE):
+        return nan, f"solution lost at t = {lost_at:.4g} s ({case.attribute('health_reason', '')})"
     value = float(column[hits[0]])
     if not math.isfinite(value):
         return nan, f"{norm} is {value} at t = {time:g}"

@@ -7,10 +7,14 @@ short, 2 with one line for a directory that cannot be read."""
 import json
 from dataclasses import replace
 
+import h5py
+import pytest
+
 import gate
-from conftest import SYNTHETIC_SUITE, synthetic_ring_cases, write_suite_directory
+import report
+from conftest import RING_TIMES, SYNTHETIC_SUITE, synthetic_ring_cases, write_suite_directory
 from results import read_suite
-from series import refinement_series
+from series import refinement_series, series_levels
 
 
 def run_gate(directory, capsys):
@@ -204,3 +208,102 @@ def test_gate_checks_a_bound_on_the_error_itself(tmp_path, capsys):
     assert "PASS" in first and "E = 0.00439 <= 0.005" in first
     assert "FAIL" in second and "error above 0.001: cells=64: 0.0011" in second
     assert "1 of 2 expectations fell short" in out
+
+
+def test_a_lost_case_is_not_completed_anywhere(tmp_path, capsys):
+    """Requirement: a case whose results file says its solution was lost (status
+    "lost", with the health verdict's reason and time) counts as not completed
+    even where the manifest says "completed": the gate fails a must_complete
+    expectation naming the rule and the time, no order is fitted through it,
+    and the report's case table shows the status and the reason."""
+    directory = write_suite_directory(tmp_path / "suite", SYNTHETIC_SUITE, synthetic_ring_cases())
+    with h5py.File(directory / "cases" / "ring-method=cpdi-cells=64.h5", "r+") as f:
+        f.attrs.update({"status": "lost", "failure_reason": "solution lost", "health": "solution lost",
+                        "health_time": 0.5, "health_reason": "J / J_exact ranged over [0.0064, 25.6], outside "
+                                                            "[1/20, 20] (health_J_factor)"})
+    suite = read_suite(directory)
+    lost = next(c for c in suite.cases if c.id == "ring-method=cpdi-cells=64")
+    assert lost.status == "lost" and not lost.completed
+    assert lost.failure_reason.startswith("solution lost at t = 0.5 s: J / J_exact ranged over [0.0064, 25.6]")
+    status, out, _ = run_gate(directory, capsys)
+    assert status == 1
+    row = next(r for r in rows_of(out) if r.startswith("1 "))
+    assert "FAIL" in row and "cells=64 lost (solution lost at t = 0.5 s: J / J_exact" in row
+    # Its errors from t = 0.5 s on are refused; before, they are usable, as a failed run's are.
+    cpdi = refinement_series(suite.cases_of("ring"))[1]
+    at_end = {l.value: l for l in series_levels(cpdi, "L1_theta0", 1.0)}
+    assert at_end[64].reason.startswith("solution lost at t = 0.5 s (J / J_exact")
+    assert at_end[32].reason == "" and at_end[128].reason == ""
+    early = {l.value: l for l in series_levels(cpdi, "L1_theta0", 0.25)}
+    assert early[64].reason == "" and early[64].error == pytest.approx(0.5 * (3.0 / 64) ** 2 * 0.25, rel=1e-12)
+    table = report.case_table(suite)
+    cells = next(r for r in table.rows if r[0] == "ring-method=cpdi-cells=64")
+    assert cells[1] == "lost" and "health_J_factor" in cells[3]
+
+
+NOISY_SUITE = """description = "synthetic: cpdi errors 0.5 h^2 times 1, 1.3, 0.8, 1.2 on 32-256 cells"
+
+[[study]]
+name = "ring"
+scene = "scenes/ring.toml"
+sweep = { method = ["cpdi"], cells = [32, 64, 128, 256] }
+
+[[expect]]
+study = "ring"
+norm = "L1_theta0"
+order = 2.0
+tolerance = 0.5
+
+[[expect]]
+study = "ring"
+norm = "L1_theta0"
+order = 2.0
+tolerance = 0.5
+interval_within_band = true
+
+[[expect]]
+study = "ring"
+norm = "L1_theta0"
+order = 2.0
+tolerance = 0.8
+interval_within_band = true
+
+[[expect]]
+study = "ring"
+norm = "L1_theta0"
+levels = [32, 64]
+order = 2.0
+tolerance = 0.8
+interval_within_band = true
+"""
+
+
+def test_an_interval_outside_the_band_is_noted_or_fails_when_asked(tmp_path, capsys):
+    """Requirement: errors 0.5 h^2 scattered by +-30 % fit order 1.99 with the 95 %
+    interval [1.26, 2.72] (reports/orders.py); against the band [1.5, 2.5] that
+    passes with a note, fails with interval_within_band, and passes it against
+    [1.2, 2.8]; two levels give no interval, which interval_within_band refuses."""
+    cases = []
+    for cells, factor in zip((32, 64, 128, 256), (1.0, 1.3, 0.8, 1.2)):
+        h = 3.0 / cells
+        keys = {"method": "cpdi", "cells": cells, "end_time": 1.0, "output_times": RING_TIMES}
+        cases.append({"id": f"ring-method=cpdi-cells={cells}", "study": "ring", "keys": keys, "status": "completed",
+                      "h": h, "times": RING_TIMES, "errors": {"L1_theta0": [0.5 * h * h * factor * t for t in RING_TIMES]}})
+    directory = write_suite_directory(tmp_path / "suite", NOISY_SUITE, cases)
+    status, out, _ = run_gate(directory, capsys)
+    assert status == 1
+    rows = {r.split()[0]: r for r in rows_of(out)}
+    assert "PASS" in rows["1"] and "1.991 [1.26, 2.72]" in rows["1"]
+    assert "its 95% interval [1.26, 2.72] reaches outside [1.5, 2.5]" in rows["1"]
+    assert "FAIL" in rows["2"] and "95% interval [1.26, 2.72] not within [1.5, 2.5]" in rows["2"]
+    assert "PASS" in rows["3"] and "reaches outside" not in rows["3"]
+    assert "FAIL" in rows["4"] and "2 usable levels give no confidence interval" in rows["4"]
+
+
+def test_interval_within_band_needs_an_order(tmp_path, capsys):
+    """Requirement: interval_within_band without an order is a malformed [[expect]] (exit 2, one line)."""
+    suite = NOISY_SUITE.split("[[expect]]")[0] + "[[expect]]\nstudy = \"ring\"\nnorm = \"L1_theta0\"\n" \
+        "max_error = 1.0\ninterval_within_band = true\n"
+    directory = write_suite_directory(tmp_path / "suite", suite, [])
+    status, _, err = run_gate(directory, capsys)
+    assert status == 2 and "'interval_within_band' needs an 'order'" in err

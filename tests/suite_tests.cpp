@@ -139,6 +139,12 @@ TEST(SuiteFile, MistakesNameFileLineAndKey) {
       {study + "sweep = { cells = [32, 64] }\n[[expect]]\nstudy = \"a\"\nnorm = \"L1_theta0\"\norder = 2\ntolerance = 0.1\n"
                "levels = [32, 128]\n",
        "study 'a' has no case with cells = 128"},
+      {study + "sweep = { cells = [32, 64] }\n[[expect]]\nstudy = \"a\"\nnorm = \"L1_theta0\"\nmax_error = 1.0\n"
+               "interval_within_band = true\n",
+       "'interval_within_band' needs an 'order'"},
+      {study + "sweep = { cells = [32, 64] }\n[[expect]]\nstudy = \"a\"\nnorm = \"L1_theta0\"\norder = 2\n"
+               "tolerance = 0.1\ninterval_within_band = 1\n",
+       "'interval_within_band' must be true or false"},
       {study + "set = { inner_radius = 1.3 }\n", "key 'outer_radius': must exceed inner_radius = 1.3 (from"},
       {study + "sweep = { cells = [32, 64] }\n[[reference]]\nsource = \"x\"\nstudy = \"a\"\nquantity = \"time_reached\"\n"
                "columns = [\"cells\"]\nrows = [[32, 0.4], [128, 0.3]]\n",
@@ -167,6 +173,9 @@ TEST(SuiteFile, MistakesNameFileLineAndKey) {
       {study + "[[reference]]\nsource = \"x\"\nstudy = \"a\"\nquantity = \"time_reached\"\nrows = [[1.0]]\nlevel = 3\n",
        "s.toml:9: unknown key 'level' in [[reference]]"},
       {"[[study]]\nname = \"a b\"\n", "may hold only letters, digits"},
+      {"[[study]]\nname = \"" + std::string(240, 'x') + "\"\nscene = \"" + kScenes +
+           "/ring.toml\"\nsweep = { cells = [32] }\n",
+       "characters long, more than the 244 a file name leaves it"},
       {"[[study]\n", "TOML syntax error"},
   };
   for (const Case& c : cases) {
@@ -240,6 +249,38 @@ TEST(SuiteRunner, ResumeRunsOnlyWhatIsMissing) {
   EXPECT_EQ(count(read(dir / "out" / "manifest.json"), "kept from an earlier run"), 2);
 }
 
+// A rerun does not keep a results file made with a deliberate fault when none
+// is asked for now, nor one without its error table: both run again.
+TEST(SuiteRunner, ResumeRunsFaultedAndDamagedResultsAgain) {
+  const fs::path dir = scratch("resume-faulted");
+  const fs::path suite = write(dir / "s.toml", small_suite());
+  const std::string run = std::string(MPMVV_BINARY) + " suite " + suite.string() + " -j 2 -q -o " + (dir / "out").string();
+  ASSERT_EQ(shell("MPMVV_FAULT=no-body-force MPMVV_FAULT_ONLY=cells=8 " + run), 0);
+  const fs::path faulted = dir / "out/cases/square-cells=8.h5";
+  ASSERT_TRUE(mpmvv::h5::File::open_read(faulted.string()).root().has_attribute("fault_injected"));
+  ASSERT_EQ(shell(run), 0);
+  std::string manifest = read(dir / "out" / "manifest.json");
+  EXPECT_EQ(count(manifest, "kept from an earlier run"), 2) << manifest;
+  EXPECT_FALSE(mpmvv::h5::File::open_read(faulted.string()).root().has_attribute("fault_injected"));
+  // The same fault asked for again keeps the file made with it.
+  ASSERT_EQ(shell("MPMVV_FAULT=no-body-force MPMVV_FAULT_ONLY=cells=8 " + run), 0);
+  ASSERT_EQ(shell("MPMVV_FAULT=no-body-force MPMVV_FAULT_ONLY=cells=8 " + run), 0);
+  EXPECT_EQ(count(read(dir / "out" / "manifest.json"), "kept from an earlier run"), 3);
+  // A results file whose /errors group is gone.
+  ASSERT_EQ(shell(run), 0);
+  const fs::path damaged = dir / "out/cases/square-cells=12.h5";
+  {
+    const hid_t file = H5Fopen(damaged.string().c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    ASSERT_GE(file, 0);
+    EXPECT_GE(H5Ldelete(file, "errors", H5P_DEFAULT), 0);
+    H5Fclose(file);
+  }
+  ASSERT_EQ(shell(run), 0);
+  manifest = read(dir / "out" / "manifest.json");
+  EXPECT_EQ(count(manifest, "kept from an earlier run"), 2) << manifest;
+  EXPECT_TRUE(mpmvv::h5::File::open_read(damaged.string()).root().has("errors"));
+}
+
 // --only runs the cases whose id the regular expression finds and leaves the
 // others pending, to be run (or kept) by a later run; a bad expression is bad
 // input.
@@ -257,6 +298,9 @@ TEST(SuiteRunner, OnlyRunsTheSelectedCases) {
   EXPECT_EQ(count(manifest, "\"status\": \"completed\""), 3) << manifest;
   EXPECT_EQ(count(manifest, "kept from an earlier run"), 2) << manifest;
   EXPECT_EQ(shell(run + " --only '('"), 2);
+  // A selection of nothing is a mistake, not a finished run.
+  EXPECT_EQ(shell(run + " --only 'cells=99'"), 2);
+  EXPECT_EQ(shell(std::string(MPMVV_BINARY) + " suite " + suite.string() + " --list --only 'cells=99'"), 2);
 }
 
 // --threads sets every case's OpenMP threads (two suites sharing the

@@ -247,6 +247,16 @@ class MmsCase final : public SceneCase, private RunObserver {
   std::size_t particle_count() const override { return stepper_ ? stepper_->model().particles.size() : 0; }
   const ErrorTable& errors() const override { return errors_; }
 
+  RunHealth health() const override {
+    std::vector<HealthSample> samples;
+    for (const MonitorRow& r : monitor_rows_)
+      samples.push_back({r.time, r.min_J_ratio, r.max_J_ratio, r.worst_J_reference, r.created, r.energy_scale});
+    return judge_health(samples, errors_,
+                        {config_.real("health_J_factor"), config_.real("health_energy_loss_factor"),
+                         setup_.exact_motion},
+                        sampled_motion_);
+  }
+
   std::string error_description() const override {
     return "L1_<line>: eq. 3.1 of 000_1dbcb8acb6dddab9.txt, the mean over the line's material points of "
            "|q_sim - q_exact| for the line's quantity (its 'quantity' attribute; rad or m); particle_L1, "
@@ -327,7 +337,7 @@ class MmsCase final : public SceneCase, private RunObserver {
                     "the run's health at each output time (solver/monitors.hpp): kinetic and strain energy, the work "
                     "done on the particles by body forces and tractions, node constraints, contact and damping, the "
                     "energy made from nothing (kinetic + strain - initial - work), the angular momentum about the origin and the "
-                    "exact motion's over the same particles [kg m^2/s per unit depth; NaN in r-z], J's range, the largest particle "
+                    "exact motion's over the same particles [kg m^2/s per unit depth; NaN in r-z], J's range and that of J / J_exact (J_exact = 1 without an exact motion), the largest particle "
                     "speed over its wave speed, the largest CPDI domain distortion (1: square), particles at the "
                     "grid's edge, CPDI corner domains turned over, and what lifts the signal speed of the CFL step above the small-strain wave speed: "
                     "the particle's state and density (max c_p / c0, c0 at the reference density) and the basis (max k_p) [J per unit depth; per radian in r-z]");
@@ -350,6 +360,8 @@ class MmsCase final : public SceneCase, private RunObserver {
     column("exact_angular_momentum", [](const MonitorRow& r) { return r.exact_angular_momentum; });
     column("min_J", [](const MonitorRow& r) { return r.monitors.min_J; });
     column("max_J", [](const MonitorRow& r) { return r.monitors.max_J; });
+    column("min_J_over_exact", [](const MonitorRow& r) { return r.min_J_ratio; });
+    column("max_J_over_exact", [](const MonitorRow& r) { return r.max_J_ratio; });
     column("max_speed_over_wave_speed", [](const MonitorRow& r) { return r.monitors.max_mach; });
     column("max_domain_distortion", [](const MonitorRow& r) { return r.monitors.max_distortion; });
     column("particles_near_edge", [](const MonitorRow& r) { return double(r.monitors.near_edge); });
@@ -602,6 +614,7 @@ class MmsCase final : public SceneCase, private RunObserver {
     initial_energy_ = m.kinetic + m.strain;
     largest_energy_ = initial_energy_;
     monitor_rows_.clear();
+    sampled_motion_ = 0.0;
     stop_ = {};
   }
 
@@ -635,7 +648,8 @@ class MmsCase final : public SceneCase, private RunObserver {
         exact_spin += P.mass[p] * (f.position.x() * f.velocity.y() - f.position.y() * f.velocity.x());
       }
     }
-    monitor_rows_.push_back({t, m, w, created, frequency, cfl_step, exact_spin});
+    monitor_rows_.push_back({t, m, w, created, frequency, cfl_step, exact_spin, largest_energy_, m.min_J, m.max_J,
+                             Vec2::Constant(std::numeric_limits<double>::quiet_NaN())});
     const double factor = config_.real("energy_blowup_factor");
     if (created > factor * largest_energy_ && created > 0.0)
       stop_ = {"energy blow-up",
@@ -644,9 +658,46 @@ class MmsCase final : public SceneCase, private RunObserver {
                            t, created, created / largest_energy_, largest_energy_, factor)};
   }
 
+  // The range of J_p / J_exact at this output time into its monitor row; a
+  // ratio that is not a number (a NaN J) counts as farthest of all.
+  void record_J_ratio(const Particles& P) {
+    MonitorRow& row = monitor_rows_.back();
+    row.min_J_ratio = std::numeric_limits<double>::infinity();
+    row.max_J_ratio = 0.0;
+    double farthest = -1.0;
+    bool not_a_number = false;
+    for (std::size_t p = 0; p < j_ratio_.size(); ++p) {
+      const double r = j_ratio_[p];
+      const double distance = r > 0.0 ? std::abs(std::log(r)) : std::numeric_limits<double>::infinity();
+      if (!(distance <= farthest)) {  // NaN is farther than anything
+        farthest = distance;
+        row.worst_J_reference = P.reference_position[p];
+      }
+      not_a_number = not_a_number || std::isnan(r);
+      row.min_J_ratio = std::min(row.min_J_ratio, r);
+      row.max_J_ratio = std::max(row.max_J_ratio, r);
+    }
+    if (not_a_number) row.min_J_ratio = row.max_J_ratio = std::numeric_limits<double>::quiet_NaN();
+  }
+
   void step_rule(double dt) override { rule_step_ = dt; }
 
+  // The RMS exact displacement over every k-th particle (about 256 of them,
+  // weighted by reference volume), after every step: the health verdict's
+  // measure of the whole motion between the output times (health.hpp).
+  void sample_motion(double t, const Particles& P) {
+    const std::size_t n = P.size(), stride = std::max<std::size_t>(1, n / 256);
+    double weight = 0.0, exact2 = 0.0;
+    for (std::size_t p = 0; p < n; p += stride) {
+      const Vec2 X = P.reference_position[p];
+      weight += P.reference_volume[p];
+      exact2 += P.reference_volume[p] * (setup_.solution->position(X, t) - X).squaredNorm();
+    }
+    if (weight > 0.0) sampled_motion_ = std::max(sampled_motion_, std::sqrt(exact2 / weight));
+  }
+
   void after_step(double t, const Stepper& s) override {
+    if (setup_.exact_motion) sample_motion(t, s.model().particles);
     if (setup_.history) {
       const std::vector<double> values = setup_.history(t, s);
       history_time_.push_back(t);
@@ -718,9 +769,12 @@ class MmsCase final : public SceneCase, private RunObserver {
       const std::size_t n = P.size();
       const bool axisymmetric = setup_.geometry == Geometry::axisymmetric;  // F_33 = F_theta (out_of_plane_stretch)
       double pressure = 0.0, deformation = 0.0, velocity = 0.0;
+      j_ratio_.resize(n);
 #pragma omp parallel for schedule(static) reduction(+ : pressure, deformation, velocity)
       for (std::size_t p = 0; p < n; ++p) {
         const mms::ExactFields f = setup_.solution->fields(P.reference_position[p], t);
+        j_ratio_[p] = determinant(P.deformation_gradient[p]) * (axisymmetric ? P.hoop_stretch[p] : 1.0) /
+                      (determinant(f.deformation_gradient) * f.hoop_stretch);
         const double e = 0.5 * ((P.stress[p] - f.cauchy_stress).trace());
         pressure += P.reference_volume[p] * e * e;
         const double e33 = (axisymmetric ? P.hoop_stretch[p] : 1.0) - f.hoop_stretch;
@@ -728,6 +782,7 @@ class MmsCase final : public SceneCase, private RunObserver {
         deformation += P.reference_volume[p] * (e_in_plane + e33 * e33);
         velocity += P.reference_volume[p] * (P.velocity[p] - f.velocity).squaredNorm();
       }
+      record_J_ratio(P);
       errors_.columns[column++].second.push_back(std::sqrt(pressure / weight));
       errors_.columns[column++].second.push_back(std::sqrt(deformation / weight));
       errors_.columns[column++].second.push_back(std::sqrt(velocity / weight));
@@ -773,8 +828,16 @@ class MmsCase final : public SceneCase, private RunObserver {
     double created;
     double largest_frequency, cfl_step;  // with stable_step_iterations > 0
     double exact_angular_momentum;       // NaN without an exact motion (or in r-z)
+    double energy_scale;                 // the balance's scale at this time (record_monitors)
+    // The range of J_p / J_exact(X_p, t) over the particles (J_exact = 1
+    // without an exact motion), and the reference position of the particle
+    // farthest from 1 in ratio (RunHealth).
+    double min_J_ratio, max_J_ratio;
+    Vec2 worst_J_reference;
   };
   std::vector<MonitorRow> monitor_rows_;
+  std::vector<double> j_ratio_;  // J_p / J_exact at the last output time (exact motion only)
+  double sampled_motion_ = 0.0;  // the largest RMS exact displacement sampled after a step (sample_motion)
   double initial_energy_ = 0.0, largest_energy_ = 0.0;
   double rule_step_ = std::numeric_limits<double>::quiet_NaN();  // the time-step rule's last step
   std::pair<std::string, std::string> stop_;

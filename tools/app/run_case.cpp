@@ -86,8 +86,15 @@ void set_key_attribute(h5::Group& root, const std::string& name, const Value& v)
       v);
 }
 
+// A run that reached its end time with its solution lost (RunHealth) is not
+// "completed": its status is "lost", and its failure names the rule.
+const char* run_status(const RunOutcome& o, const RunHealth& health) {
+  if (o.completed) return health.lost ? "lost" : "completed";
+  return o.failure_reason == kInterrupted ? kInterrupted : "failed";
+}
+
 void write_results_file(const std::string& path, const RunRequest& request, const Config& config,
-                        const SceneCase& scene, const RunOutcome& o, Fault fault) {
+                        const SceneCase& scene, const RunOutcome& o, const RunHealth& health, Fault fault) {
   h5::File file = h5::File::create(path);
   h5::Group root = file.root();
   // Every scene key as an attribute of its own, then what the run measured.
@@ -108,12 +115,17 @@ void write_results_file(const std::string& path, const RunRequest& request, cons
   root.set_attribute("version", version_string());
   if (fault != Fault::none) root.set_attribute("fault_injected", to_string(fault));
   root.set_attribute("threads", std::int64_t(max_threads()));
-  root.set_attribute("status", o.completed                            ? "completed"
-                               : o.failure_reason == kInterrupted ? kInterrupted
-                                                                   : "failed");
-  root.set_attribute("failure_reason", o.failure_reason);
-  root.set_attribute("failure_detail", o.failure_detail);
-  root.set_attribute("failure_time", o.failure_time);
+  root.set_attribute("status", run_status(o, health));
+  const bool lost_at_end = o.completed && health.lost;
+  root.set_attribute("failure_reason", lost_at_end ? std::string("solution lost") : o.failure_reason);
+  root.set_attribute("failure_detail", lost_at_end ? health.reason : o.failure_detail);
+  root.set_attribute("failure_time", lost_at_end ? health.time : o.failure_time);
+  root.set_attribute("health", health.lost ? "solution lost" : "healthy");
+  root.set_attribute("health_reason", health.reason);
+  root.set_attribute("health_time", health.time);
+  if (health.reference_position)
+    root.set_attribute("health_reference_position",
+                       std::vector<double>{health.reference_position->x(), health.reference_position->y()});
   root.set_attribute("failure_step", std::int64_t(o.failure_step));
   root.set_attribute("failure_particle", std::int64_t(o.failure_particle));
   root.set_attribute("time_reached", o.time_reached);
@@ -244,9 +256,10 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
 
   // Write next to the target and rename: a killed run never leaves a file that
   // looks whole.
+  const RunHealth health = scene->health();
   const std::string partial = output + ".partial";
   try {
-    write_results_file(partial, request, config, *scene, o, fault);
+    write_results_file(partial, request, config, *scene, o, health, fault);
     fs::rename(partial, output);
   } catch (const std::exception& e) {
     std::error_code ec;
@@ -256,7 +269,15 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
   }
 
   const double rate = o.wall_seconds > 0 ? double(o.particle_steps) / o.wall_seconds : 0.0;
-  if (o.completed)
+  const std::string place =
+      health.reference_position
+          ? fmt::format(", at the particle from ({:.4g}, {:.4g})", health.reference_position->x(),
+                        health.reference_position->y())
+          : std::string();
+  if (o.completed && health.lost)
+    fmt::print(out, "{} {}: SOLUTION LOST (status \"lost\"): it ran to t = {:.4g} s in {} steps, but at t = {:.4g} s {}{}\n",
+               config.scene(), config.text("method"), o.time_reached, o.steps, health.time, health.reason, place);
+  else if (o.completed)
     fmt::print(out, "{} {}: completed t = {:.4g} s in {} steps, {:.3g} s wall ({:.3g} s forcing), {} particles, h = {:.4g} m, {:.3g} particle-steps/s\n",
                config.scene(), config.text("method"), o.time_reached, o.steps, o.wall_seconds, o.forcing_seconds,
                scene->particle_count(), scene->cell_size(), rate);
@@ -268,11 +289,13 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
                o.failure_time, o.failure_step,
                o.failure_particle >= 0 ? fmt::format(", particle {}", o.failure_particle) : std::string(),
                o.failure_reason, o.failure_detail);
+  if (!o.completed && health.lost && o.failure_reason != kInterrupted)
+    fmt::print(out, "its solution was lost before: at t = {:.4g} s {}{}\n", health.time, health.reason, place);
   print_error_table(out, scene->errors());
   print_measurements(out, scene->measurements());
   fmt::print(out, "results: {}\n", output);
   if (o.failure_reason == kInterrupted) return 130;
-  return o.completed ? 0 : 1;
+  return o.completed && !health.lost ? 0 : 1;
 }
 
 }  // namespace mpmvv::app

@@ -112,6 +112,22 @@ std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_
        "(monitors largest_frequency, stable_step, cfl_step; explicit steps only; 0: not measured, 30 is plenty; each "
        "iteration costs about two transfers)",
        0, 10000},
+      // Defaults from the ring runs on record (cpdi, cpdi-exact, uGIMP, B-splines;
+      // 30-1200 cells, soft and stiff): runs that converge reach J / J_exact
+      // 0.116-3.35, error over motion 0.15 and energy lost 0.44 at most; runs
+      // whose solution is gone reach J 0.002-0.0064 or 9-26 and error over
+      // motion 1.7-1.8 (suites/ring-sandia.toml, suites/stiff-vortex.toml).
+      {"health_J_factor", KeyKind::real, 20.0,
+       "the run's solution is called lost (status \"lost\") when at an output time a particle's J / J_exact, J = det F, "
+       "leaves [1 / health_J_factor, health_J_factor] (J_exact = 1 where the scene has no exact motion); also when a "
+       "displacement error norm exceeds the largest exact displacement of the run or is not a number, and when "
+       "energy is lost beyond health_energy_loss_factor",
+       1.0, inf, true},
+      {"health_energy_loss_factor", KeyKind::real, 1.0,
+       "the run's solution is called lost when the energy it lost to the method (kinetic plus strain energy less "
+       "their start, less the work done on it, when negative) exceeds this factor times the larger of the energy it "
+       "started with and the largest work done on it",
+       0.0, inf, true},
       {"energy_blowup_factor", KeyKind::real, 10.0,
        "at an output time the run stops with 'energy blow-up' when the energy it made from nothing (kinetic plus "
        "strain energy less their start, less the work done on it) exceeds this factor times the larger of the energy "

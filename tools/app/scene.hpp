@@ -12,6 +12,7 @@
 
 #include "config.hpp"
 #include "fault.hpp"
+#include "health.hpp"
 #include "solver/io/hdf5.hpp"
 #include "solver/model.hpp"
 #include "solver/time_loop.hpp"
@@ -51,6 +52,8 @@ class SceneCase {
   // Writes particles and probes under `root` (the errors are written from errors()).
   virtual void write_results(h5::Group& root) const = 0;
   virtual const ErrorTable& errors() const = 0;
+  // The health verdict of the run just made (health.hpp).
+  virtual RunHealth health() const = 0;
   // What the error columns mean, stored with them.
   virtual std::string error_description() const = 0;
 };

@@ -30,6 +30,7 @@
 #endif
 
 #include "config.hpp"
+#include "fault.hpp"
 #include "scene.hpp"
 #include "solver/io/hdf5.hpp"
 #include "solver/time_loop.hpp"
@@ -472,6 +473,13 @@ Suite load_suite(const std::string& path) {
         for (const KeySpec& k : specs) c.keys[k.name] = json_value(config.value(k.name));
         for (const SuiteCase& other : suite.cases)
           if (other.id == c.id) throw ConfigError(fmt::format("{}: two cases have the id '{}'", here, c.id));
+        // The id names the case's files (cases/<id>.h5.partial the longest),
+        // and a file name holds at most 255 bytes.
+        if (constexpr std::size_t longest_suffix = std::char_traits<char>::length(".h5.partial");
+            c.id.size() + longest_suffix > 255)
+          throw ConfigError(fmt::format("{}: the case id '{}...' is {} characters long, more than the {} a file name "
+                                        "leaves it: shorten the study name or the swept values",
+                                        here, c.id.substr(0, 60), c.id.size(), 255 - longest_suffix));
         suite.cases.push_back(std::move(c));
       }
       // Next combination of the sweep lists, the last key fastest.
@@ -493,7 +501,7 @@ Suite load_suite(const std::string& path) {
       const toml::table& e = *node.as_table();
       const std::string here = where_in(path, node);
       expect_only(e, {"study", "where", "norm", "time", "refine", "levels", "order", "tolerance", "max_error_constant",
-                      "max_error", "must_complete"},
+                      "max_error", "must_complete", "interval_within_band"},
                   path, "[[expect]]");
       const toml::node* study = e.get("study");
       if (!study || !study->is_string()) throw ConfigError(fmt::format("{}: [[expect]] needs the study it checks", here));
@@ -527,8 +535,11 @@ Suite load_suite(const std::string& path) {
         throw ConfigError(fmt::format("{}: [[expect]]: 'max_error_constant' must be a positive number", where_in(path, *m)));
       if (const toml::node* t = e.get("time"); t && !(t->value<double>().value_or(-1.0) >= 0.0))
         throw ConfigError(fmt::format("{}: [[expect]]: 'time' must be a time >= 0", where_in(path, *t)));
-      if (const toml::node* m = e.get("must_complete"); m && !m->is_boolean())
-        throw ConfigError(fmt::format("{}: [[expect]]: 'must_complete' must be true or false", where_in(path, *m)));
+      for (const char* k : {"must_complete", "interval_within_band"})
+        if (const toml::node* m = e.get(k); m && !m->is_boolean())
+          throw ConfigError(fmt::format("{}: [[expect]]: '{}' must be true or false", where_in(path, *m), k));
+      if (e.get("interval_within_band") && !e.get("order"))
+        throw ConfigError(fmt::format("{}: [[expect]]: 'interval_within_band' needs an 'order'", here));
       std::string refine = "cells";
       if (const toml::node* r = e.get("refine")) {
         if (!r->is_string() || !is_key(r->as_string()->get()))
@@ -651,6 +662,18 @@ std::optional<CaseState> finished_state(const fs::path& results, const SuiteCase
     std::vector<std::string> added;
     if (!same_configuration(root.attribute_string("configuration"), c.configuration, c.defaults, &added))
       return std::nullopt;
+    // A file made with a deliberate fault other than the one asked for now
+    // (tools/app/fault.hpp; none, outside a fault-injection test) is not this
+    // case's result, and a file without its error table is damaged: both run
+    // again.
+    const std::string fault = root.has_attribute("fault_injected") ? root.attribute_string("fault_injected") : "";
+    Fault now = Fault::none;
+    try {
+      now = injected_fault(results.string());
+    } catch (const ConfigError&) {
+      return std::nullopt;
+    }
+    if (fault != to_string(now) || !root.has("errors")) return std::nullopt;
     CaseState s;
     s.status = root.attribute_string("status");
     if (s.status == kInterrupted) return std::nullopt;  // stopped by a signal before its end: run it again
@@ -785,6 +808,12 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
   }
   // --only: the cases the request selects; the others stay as an earlier run left them.
   auto selected = [&](const SuiteCase& c) { return request.only.empty() || std::regex_search(c.id, only); };
+  if (std::none_of(suite.cases.begin(), suite.cases.end(), selected)) {
+    if (rank == 0)
+      fmt::print(err, "mpmvv suite: --only '{}' matches no case of {} (its ids look like '{}'; --list shows them)\n",
+                 request.only, suite.file, suite.cases.empty() ? std::string() : suite.cases.front().id);
+    return finish_mpi(2);
+  }
   if (request.list) {
     if (rank == 0) {
       fmt::print(out, "suite {}: {} cases, timeout {} s{}\n", suite.file, suite.cases.size(), suite.timeout_seconds,
@@ -893,7 +922,7 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
     std::size_t completed = 0, failed = 0, broken = 0;
     for (std::size_t i : queue) {
       if (state[i].status == "completed") ++completed;
-      else if (state[i].status == "failed") ++failed;
+      else if (state[i].status == "failed" || state[i].status == "lost") ++failed;
       else if (state[i].status != "pending" && state[i].status != "running") ++broken;
     }
     const std::size_t remaining = queue.size() - finished;
@@ -901,7 +930,7 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
     const int width = 24;
     const int filled = queue.empty() ? width : int(width * finished / queue.size());
     const std::string bar = std::string(std::size_t(filled), '#') + std::string(std::size_t(width - filled), '.');
-    const std::string line = fmt::format("{}[{}] {}/{} cases: {} completed, {} failed, {} crashed/timeout/error, {} running, ETA {}",
+    const std::string line = fmt::format("{}[{}] {}/{} cases: {} completed, {} failed or lost, {} crashed/timeout/error, {} running, ETA {}",
                                          prefix, bar, finished, queue.size(), completed, failed, broken, running.size(),
                                          duration(eta));
     if (tty) fmt::print(err, "\r{:<110}", line);
@@ -955,7 +984,7 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
             s.wall = wall;
           } else {
             s.status = "error";
-            s.detail = "the run ended without a results file";
+            s.detail = "the run ended without a usable results file (none, one without /errors, or one made with another MPMVV_FAULT)";
           }
         } else {
           s.status = "error";
@@ -1012,7 +1041,7 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
       table += fmt::format("{:<48} {:<10} {:>9.3g}  {}\n", suite.cases[i].id, case_status, wall,
                            detail.empty() ? error : detail + (error.empty() ? "" : "; " + error));
       // A case --only left out may stay pending.
-      if (case_status != "completed" && case_status != "failed" &&
+      if (case_status != "completed" && case_status != "failed" && case_status != "lost" &&
           !(case_status == "pending" && !selected(suite.cases[i])))
         status = 1;
     }
