@@ -22,6 +22,11 @@ expectation holds for a series when
   interval_within_band; it needs three or more levels). Without it, an
   interval that reaches outside the band is noted beside a PASS.
 
+A read where the exact quantity the norm measures (the mean |exact| on an
+L1_<line> norm's line, the RMS exact displacement for particle_L1, _L2,
+_Linf) is below TRIVIAL_SIGNAL (5 %) of its largest over the run is warned
+about in the row: a run without the motion would score nearly the same there.
+
 Prints one row per (expectation, series) and a closing line; exit 0 when every
 expectation holds, 1 when one falls short, 2 (one line) when DIR is not a
 readable suite output directory or an [[expect]] is malformed.
@@ -34,7 +39,7 @@ import sys
 from dataclasses import dataclass
 
 from orders import OrderFit, least_squares_order
-from results import SuiteDirectoryError, read_suite
+from results import SuiteDirectoryError, exact_signal_fraction, read_suite
 from series import DEFAULT_REFINE_KEY, Series, matches, refinement_series, series_levels, usable
 
 NUMBER = (int, float)
@@ -45,6 +50,7 @@ EXPECT_KEYS = {
     "interval_within_band": (bool,),
 }
 REQUIRED_KEYS = ("study", "norm")
+TRIVIAL_SIGNAL = 0.05   # an exact signal below this fraction of its largest is warned about
 
 
 @dataclass(frozen=True)
@@ -56,7 +62,8 @@ class Verdict:
     fit: OrderFit
     error_constant: float       # max over usable levels of E / h^order
     reasons: tuple              # why it fell short; empty when it holds
-    notes: tuple                # levels left out of a passing fit
+    notes: tuple                # levels left out of a passing fit, an interval reaching outside the band
+    warnings: tuple = ()        # a read where the exact signal is trivial (TRIVIAL_SIGNAL)
 
     @property
     def passed(self):
@@ -164,7 +171,15 @@ def check_series(number, expect, series):
         reasons.append(f"E/h^{order:g} = {constant:.3g} > {limit:g}")
     if len(good) >= (2 if has_order else 1):
         notes = interval_notes + [f"left out {series.refine}={l.value} ({l.reason})" for l in levels if l.reason]
-    return Verdict(number, expect, series, tuple(levels), fit, constant, tuple(reasons), tuple(notes))
+    read_time = expect.get("time")
+    fractions = [f for f in (exact_signal_fraction(l.case, expect["norm"],
+                                                   l.case.end_time if read_time is None else float(read_time))
+                             for l in good) if f is not None]
+    warnings = ()
+    if fractions and min(fractions) < TRIVIAL_SIGNAL:
+        warnings = (f"warning: read where the exact signal is {100 * min(fractions):.3g} % of its largest "
+                    f"(a run without the motion would score nearly the same)",)
+    return Verdict(number, expect, series, tuple(levels), fit, constant, tuple(reasons), tuple(notes), warnings)
 
 
 def _level_outcome(series, level):
@@ -224,7 +239,7 @@ def verdict_row(verdict):
         expected,
         constant,
         "PASS" if verdict.passed else "FAIL",
-        "; ".join(verdict.reasons or verdict.notes),
+        "; ".join(verdict.warnings + (verdict.reasons or verdict.notes)),
     ]
 
 

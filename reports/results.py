@@ -293,6 +293,39 @@ def read_probe_lines(path):
     return lines
 
 
+# Norms of the displacement error, measured against exact_displacement_L2.
+DISPLACEMENT_NORMS = ("particle_L1", "particle_L2", "particle_Linf")
+
+
+def exact_signal_fraction(case, norm, time):
+    """What the exact solution gives the norm to measure at output time `time`, as
+    a fraction of its largest over the run's output times: the mean |exact| on the
+    line of an L1_<line> norm (eq. 3.1's exact values), the RMS exact displacement
+    for the particle displacement norms. None where it is not known (other norms,
+    no such output, an unreadable file). A read where the fraction is small
+    measures little: a run without the motion scores nearly the same there."""
+    if case.results is None:
+        return None
+    times = case.results.error_times
+    if norm.startswith("L1_"):
+        try:
+            line = next((l for l in read_probe_lines(case.results_path) if l.name == norm[3:]), None)
+        except (OSError, KeyError, ValueError, TypeError):
+            return None
+        if line is None:
+            return None
+        times, signal = line.time, np.mean(np.abs(line.exact), axis=1)
+    elif norm in DISPLACEMENT_NORMS and "exact_displacement_L2" in case.results.errors:
+        signal = case.results.errors["exact_displacement_L2"]
+    else:
+        return None
+    hits = np.nonzero(np.abs(times - time) <= TIME_MATCH_TOLERANCE * max(1.0, abs(time)))[0]
+    largest = float(np.max(signal)) if len(signal) else 0.0
+    if hits.size == 0 or hits[0] >= len(signal) or not largest > 0.0:
+        return None
+    return float(signal[hits[0]]) / largest
+
+
 def read_point_history(path):
     """The first probe point's history (time after every step), or None."""
     with h5py.File(path, "r") as f:

@@ -307,3 +307,33 @@ def test_interval_within_band_needs_an_order(tmp_path, capsys):
     directory = write_suite_directory(tmp_path / "suite", suite, [])
     status, _, err = run_gate(directory, capsys)
     assert status == 2 and "'interval_within_band' needs an 'order'" in err
+
+
+def test_a_read_where_the_exact_signal_is_trivial_is_warned_about(tmp_path, capsys):
+    """Requirement: a read where the exact quantity the norm measures is below 5 %
+    of its largest over the run (the RMS exact displacement for particle_L2; the
+    mean |exact| on the line for an L1 line norm) is warned about in the row, for
+    a PASS as for a FAIL; a read at an informative time is not."""
+    cases = []
+    for cells in (32, 64, 128):
+        h = 3.0 / cells
+        keys = {"method": "cpdi", "cells": cells, "end_time": 1.0, "output_times": RING_TIMES}
+        errors = {"particle_L2": [0.5 * h * h] * 3, "L1_theta0": [0.5 * h * h] * 3,
+                  "exact_displacement_L2": [0.2, 0.4, 0.004]}   # 1 % of its largest at t = 1
+        cases.append({"id": f"ring-method=cpdi-cells={cells}", "study": "ring", "keys": keys, "status": "completed",
+                      "h": h, "times": RING_TIMES, "errors": errors})
+    suite = NOISY_SUITE.split("[[expect]]")[0]
+    for norm, time in (("particle_L2", 1.0), ("particle_L2", 0.5), ("L1_theta0", 0.25), ("L1_theta0", 1.0)):
+        suite += f'[[expect]]\nstudy = "ring"\nnorm = "{norm}"\ntime = {time}\norder = 2.0\ntolerance = 0.1\n'
+    suite += '[[expect]]\nstudy = "ring"\nnorm = "particle_L2"\norder = 3.0\ntolerance = 0.1\n'
+    directory = write_suite_directory(tmp_path / "suite", suite, cases)
+    status, out, _ = run_gate(directory, capsys)
+    rows = {r.split()[0]: r for r in rows_of(out)}
+    warning = "warning: read where the exact signal is 1 % of its largest"
+    assert "PASS" in rows["1"] and warning in rows["1"]
+    assert "PASS" in rows["2"] and "warning" not in rows["2"]
+    # The synthetic line's exact values are sin(pi (R - 0.75) / 0.5) t: at t = 0.25 a quarter of their largest.
+    assert "PASS" in rows["3"] and "warning" not in rows["3"]
+    assert "PASS" in rows["4"] and "warning" not in rows["4"]
+    assert "FAIL" in rows["5"] and warning in rows["5"] and "order 2.000 outside [2.9, 3.1]" in rows["5"]
+    assert status == 1
