@@ -212,8 +212,10 @@ def verdict_row(verdict):
     """The table cells of one verdict."""
     expect = verdict.expectation
     fit = verdict.fit
-    observed = "-" if not math.isfinite(fit.order) else f"{fit.order:.3f}"
-    if math.isfinite(fit.ci_low):
+    # An expectation on the error alone (max_error, for errors at round-off or
+    # settling level) claims no order: none is shown beside it.
+    observed = "-" if not math.isfinite(fit.order) or "order" not in expect else f"{fit.order:.3f}"
+    if math.isfinite(fit.ci_low) and "order" in expect:
         observed += f" [{fit.ci_low:.2f}, {fit.ci_high:.2f}]"
     used = [str(l.value) for l in verdict.levels if not l.reason]
     limit = expect.get("max_error_constant")

@@ -208,6 +208,9 @@ def test_gate_checks_a_bound_on_the_error_itself(tmp_path, capsys):
     assert "PASS" in first and "E = 0.00439 <= 0.005" in first
     assert "FAIL" in second and "error above 0.001: cells=64: 0.0011" in second
     assert "1 of 2 expectations fell short" in out
+    # Such an expectation claims no order, and none is shown (the observed-order column is "-").
+    assert "2.000" not in first and first.split()[first.split().index("32,64,128") + 1] == "-"
+    assert "2.000" not in second
 
 
 def test_a_lost_case_is_not_completed_anywhere(tmp_path, capsys):
