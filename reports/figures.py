@@ -96,7 +96,7 @@ def _finite_positive(x, y):
     return [a for a, _ in pairs], [b for _, b in pairs]
 
 
-def error_against_h(curves, title, y_label):
+def error_against_h(curves, title, y_label, x_label="cell size h [m]"):
     figure, axes = plt.subplots(figsize=(10.5, 5.0), constrained_layout=True)
     all_h, all_e = [], []
     for curve in curves:
@@ -119,7 +119,7 @@ def error_against_h(curves, title, y_label):
         _reference_slopes(axes, min(all_h), max(all_h), min(all_e))
     axes.set_xscale("log")
     axes.set_yscale("log")
-    axes.set_xlabel("cell size h [m]")
+    axes.set_xlabel(x_label)
     axes.set_ylabel(y_label)
     axes.set_title(title)
     axes.grid(True, which="both", alpha=0.3)

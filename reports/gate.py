@@ -40,7 +40,7 @@ from dataclasses import dataclass
 
 from orders import OrderFit, least_squares_order
 from results import SuiteDirectoryError, exact_signal_fraction, read_suite
-from series import DEFAULT_REFINE_KEY, Series, matches, refinement_series, series_levels, usable
+from series import DEFAULT_REFINE_KEY, Series, matches, refinement_series, series_levels, size_name, usable
 
 NUMBER = (int, float)
 EXPECT_KEYS = {
@@ -152,7 +152,7 @@ def check_series(number, expect, series):
             reasons.append("the error is exactly zero at " + ", ".join(f"{series.refine}={l.value}" for l in zero)
                            + ": no order can be fitted (does the run measure this norm?)")
         else:
-            reasons.append("cell size h does not vary over the usable levels: no order")
+            reasons.append(f"{size_name(series.refine).split(' [')[0]} does not vary over the usable levels: no order")
     elif not order - tolerance <= fit.order <= order + tolerance:
         reasons.append(f"order {fit.order:.3f} outside [{order - tolerance:g}, {order + tolerance:g}]")
     interval_notes = []

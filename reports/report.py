@@ -36,7 +36,7 @@ import orders
 import references
 from results import (SuiteDirectoryError, lookup_error, read_contact_pressure, read_error_spectrum, read_monitors,
                      read_point_history, read_probe_lines, read_scene_history, read_suite, relative_energy_created)
-from series import DEFAULT_REFINE_KEY, refinement_series, series_levels, usable
+from series import DEFAULT_REFINE_KEY, refined_size, refinement_series, series_levels, size_name, usable
 
 ORDERS_CSV_COLUMNS = (
     ("study", "the study"),
@@ -46,7 +46,8 @@ ORDERS_CSV_COLUMNS = (
     ("time", "output time [s]"),
     ("refine", "the key that refines"),
     ("levels", "its values at the usable levels, coarse first, ';'-separated"),
-    ("h", "cell size at those levels [m]"),
+    ("h", "the size the refine key sets at those levels: cell size h [m]; h / particles_per_direction [m] for "
+          "particles per direction; cfl h [m] for cfl; 1 / load_steps (reports/series.py: REFINED_SIZES)"),
     ("error", "the norm at those levels"),
     ("pairwise_orders", "orders between consecutive usable levels"),
     ("ls_order", "least-squares order"),
@@ -54,7 +55,7 @@ ORDERS_CSV_COLUMNS = (
     ("ci_high", "upper end"),
     ("classification", "asymptotic, non-asymptotic, stalled, unchecked (2 levels) or too few levels"),
     ("finest_level", "refine value of the finest usable level"),
-    ("finest_h", "its cell size [m]"),
+    ("finest_h", "its size (as h)"),
     ("finest_error", "its error"),
     ("left_out", "levels without a usable value at that time, and why"),
 )
@@ -171,11 +172,13 @@ def gci_rows(suite):
 
 
 def gci_row(series):
-    finest = [c for c in series.cases if c.completed and math.isfinite(c.h)][-3:]
+    size = {c.id: refined_size(c, series.refine) for c in series.cases}
+    finest = [c for c in series.cases if c.completed and math.isfinite(size[c.id])][-3:]
     if len(finest) < 3:
         return None
-    ratio = finest[0].h / finest[1].h
-    if not math.isclose(ratio, finest[1].h / finest[2].h, rel_tol=1e-6):
+    ratio = size[finest[0].id] / size[finest[1].id]
+    # A constant refinement ratio above 1 (a series whose size does not fall has none).
+    if not ratio > 1.0 or not math.isclose(ratio, size[finest[1].id] / size[finest[2].id], rel_tol=1e-6):
         return None
     histories = [read_point_history(c.results_path) for c in finest]
     if any(h is None or h.time.size == 0 for h in histories):
@@ -271,11 +274,12 @@ def error_figure(study, norm, time, rows, styles, quantities, directory):
     curves = [figures.Curve(r.series.label, [l.h for l in r.levels], [l.error for l in r.levels],
                             styles[r.series.label], r.fit) for r in chosen]
     unit = chosen[0].unit
-    figure = figures.error_against_h(curves, f"{study}: {norm} at {when}", f"{norm} [{unit}]")
+    against = size_name(chosen[0].series.refine)
+    figure = figures.error_against_h(curves, f"{study}: {norm} at {when}", f"{norm} [{unit}]", against)
     path = directory / f"{slug(study, 'error', norm, 'end' if time is None else time)}.png"
     figures.save_png(figure, path)
     missing = [r.series.label for r in chosen if not r.levels]
-    caption = (f"{study}: {norms.describe_norm(norm, quantities)} [{unit}] at {when} against cell size h; "
+    caption = (f"{study}: {norms.describe_norm(norm, quantities)} [{unit}] at {when} against {against}; "
                f"dashed: least-squares fit; grey: slopes 1 and 2.")
     if missing:
         caption += f" No usable level: {'; '.join(missing)}."

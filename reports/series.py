@@ -39,11 +39,40 @@ class Series:
         return ", ".join(f"{key}={value}" for key, value in keys.items()) or "all cases"
 
 
+# What a refine key other than the cell count refines, and the size it sets,
+# the abscissa of an order fit (E = C size^p): the particle spacing h / ppd for
+# particles per direction at fixed h (the marker refinement of
+# 000_1dbcb8acb6dddab9.txt), the time step for cfl at fixed h (dt = cfl h /
+# (wave speed + particle speed): in proportion to cfl h), and the load step
+# (1 / load_steps) of an implicit run. Any other key is fitted against h.
+REFINED_SIZES = {
+    "particles_per_direction": ("particle spacing h / ppd [m]", lambda c: c.h / float(c.keys["particles_per_direction"])),
+    "cfl": ("time step, as cfl h [m]", lambda c: float(c.keys["cfl"]) * c.h),
+    "load_steps": ("load step 1 / load_steps", lambda c: 1.0 / float(c.keys["load_steps"])),
+}
+CELL_SIZE = "cell size h [m]"
+
+
+def size_name(refine):
+    """What an order against the refine key is fitted against."""
+    return REFINED_SIZES[refine][0] if refine in REFINED_SIZES else CELL_SIZE
+
+
+def refined_size(case, refine):
+    """The case's size along the refine key (REFINED_SIZES; else its cell size h)."""
+    if refine in REFINED_SIZES and math.isfinite(case.h):
+        try:
+            return REFINED_SIZES[refine][1](case)
+        except (KeyError, TypeError, ValueError, ZeroDivisionError):
+            return float("nan")
+    return case.h
+
+
 @dataclass(frozen=True)
 class Level:
     case: object          # results.Case, or None for a requested level no case has
     value: object         # the refine key's value
-    h: float
+    h: float              # the size the refine key sets (refined_size): h for cells
     error: float          # NaN when the level is not usable
     reason: str           # why the level is not usable; "" when it is
 
@@ -113,10 +142,10 @@ def _follows(cases, name, refine):
 
 
 def _coarse_first(cases, refine):
-    known = sorted((c for c in cases if math.isfinite(c.h)), key=lambda c: -c.h)
+    known = sorted((c for c in cases if math.isfinite(refined_size(c, refine))), key=lambda c: -refined_size(c, refine))
     numeric = all(isinstance(c.keys[refine], (int, float)) for c in cases)
     if len(known) == len(cases) or not numeric:
-        return known + [c for c in cases if not math.isfinite(c.h)]
+        return known + [c for c in cases if not math.isfinite(refined_size(c, refine))]
     h_falls_as_value_grows = len(known) < 2 or known[0].keys[refine] <= known[-1].keys[refine]
     return sorted(cases, key=lambda c: c.keys[refine] if h_falls_as_value_grows else -c.keys[refine])
 
@@ -134,7 +163,7 @@ def series_levels(series, norm, time=None, levels=None):
                   for v in levels if v not in present]
     for case in chosen:
         error, reason = lookup_error(case, norm, case.end_time if time is None else time)
-        result.append(Level(case, case.keys[series.refine], case.h, error, reason))
+        result.append(Level(case, case.keys[series.refine], refined_size(case, series.refine), error, reason))
     return result
 
 

@@ -340,3 +340,68 @@ def test_a_read_where_the_exact_signal_is_trivial_is_warned_about(tmp_path, caps
     assert "PASS" in rows["4"] and "warning" not in rows["4"]
     assert "FAIL" in rows["5"] and warning in rows["5"] and "order 2.000 outside [2.9, 3.1]" in rows["5"]
     assert status == 1
+
+
+PPD_SUITE = """description = "synthetic: particles per direction 1, 2, 4 at 64 cells; cfl 0.4, 0.2, 0.1 at 64 cells"
+
+[[study]]
+name = "markers"
+scene = "scenes/ring.toml"
+sweep = { particles_per_direction = [1, 2, 4] }
+
+[[study]]
+name = "steps"
+scene = "scenes/ring.toml"
+sweep = { cfl = [0.4, 0.2, 0.1] }
+
+[[expect]]
+study = "markers"
+norm = "L1_theta0"
+refine = "particles_per_direction"
+order = 2.0
+tolerance = 0.1
+
+[[expect]]
+study = "steps"
+norm = "L1_theta0"
+refine = "cfl"
+order = 1.0
+tolerance = 0.1
+
+[[expect]]
+study = "markers"
+norm = "particle_L2"
+refine = "particles_per_direction"
+order = 2.0
+tolerance = 0.1
+"""
+
+
+def test_orders_against_particles_per_direction_and_the_time_step(tmp_path, capsys):
+    """Requirement: at a fixed cell size, a study refining particles per direction
+    is fitted against the particle spacing h / ppd and one refining cfl against the
+    time step (cfl h): E = 3 (h / ppd)^2 gives order 2 and E = 0.05 cfl h order 1;
+    a norm that does not change with the key has no order, and the reason names
+    the spacing, not h."""
+    h = 3.0 / 64
+    cases = []
+    for ppd in (1, 2, 4):
+        keys = {"method": "cpdi", "cells": 64, "particles_per_direction": ppd, "cfl": 0.3, "end_time": 1.0,
+                "output_times": RING_TIMES}
+        cases.append({"id": f"markers-particles_per_direction={ppd}", "study": "markers", "keys": keys,
+                      "status": "completed", "h": h, "times": RING_TIMES,
+                      "errors": {"L1_theta0": [3.0 * (h / ppd) ** 2] * 3, "particle_L2": [1e-3] * 3}})
+    for cfl in (0.4, 0.2, 0.1):
+        keys = {"method": "cpdi", "cells": 64, "particles_per_direction": 2, "cfl": cfl, "end_time": 1.0,
+                "output_times": RING_TIMES}
+        cases.append({"id": f"steps-cfl={cfl}", "study": "steps", "keys": keys, "status": "completed", "h": h,
+                      "times": RING_TIMES, "errors": {"L1_theta0": [0.05 * cfl * h] * 3}})
+    directory = write_suite_directory(tmp_path / "suite", PPD_SUITE, cases)
+    status, out, _ = run_gate(directory, capsys)
+    rows = {r.split()[0]: r for r in rows_of(out)}
+    assert "PASS" in rows["1"] and "2.000" in rows["1"] and "1,2,4" in rows["1"]
+    assert "PASS" in rows["2"] and "1.000" in rows["2"] and "0.4,0.2,0.1" in rows["2"]
+    assert "FAIL" in rows["3"] and "order 0.000 outside" in rows["3"]
+    assert status == 1
+    series = refinement_series(read_suite(directory).cases_of("markers"), "particles_per_direction")
+    assert [l.h for l in series_levels(series[0], "L1_theta0")] == pytest.approx([h, h / 2, h / 4])
