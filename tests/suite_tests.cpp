@@ -4,7 +4,10 @@
 // built `mpmvv`, so ctest runs them one at a time.
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cstdlib>
@@ -387,3 +390,38 @@ int quick_suite_gate(const std::string& fault, const std::string& name) {
 TEST(Gate, QuickSuitePasses) { EXPECT_EQ(quick_suite_gate("", "gate-healthy"), 0); }
 TEST(Gate, FailsWithoutTheBodyForce) { EXPECT_EQ(quick_suite_gate("no-body-force", "gate-no-force"), 1); }
 TEST(Gate, FailsWithPerturbedCpdiGradients) { EXPECT_EQ(quick_suite_gate("cpdi-gradient", "gate-gradient"), 1); }
+
+// One suite at a time on a directory: while another process holds DIR/.lock a
+// second suite is refused with one line (exit 2) and writes nothing; a
+// directory with another suite's manifest is refused unless --force.
+TEST(SuiteRunner, ADirectoryInUseOrOfAnotherSuiteIsRefused) {
+  const fs::path dir = scratch("lock");
+  const fs::path suite = write(dir / "s.toml", small_suite(3));
+  const fs::path out = dir / "out";
+  fs::create_directories(out);
+  const std::string run = std::string(MPMVV_BINARY) + " suite " + suite.string() + " -j 2 -q -o " + out.string();
+  {
+    const int fd = ::open((out / ".lock").c_str(), O_RDWR | O_CREAT, 0644);
+    ASSERT_GE(fd, 0);
+    ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
+    const std::string message = dir / "message.txt";
+    const int status = std::system((run + " 2> " + message).c_str());
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 2);
+    EXPECT_NE(read(message).find("another mpmvv suite is running in this directory"), std::string::npos)
+        << read(message);
+    EXPECT_FALSE(fs::exists(out / "manifest.json"));
+    ::close(fd);
+  }
+  ASSERT_EQ(shell(run), 0);
+  // The same directory for another suite.
+  const fs::path other = write(dir / "other.toml", small_suite(3));
+  const std::string run_other =
+      std::string(MPMVV_BINARY) + " suite " + other.string() + " -j 2 -q -o " + out.string();
+  const std::string message = dir / "other.txt";
+  const int status = std::system((run_other + " 2> " + message).c_str());
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 2);
+  EXPECT_NE(read(message).find("holds the results of suite 's'"), std::string::npos) << read(message);
+  EXPECT_NE(read(out / "manifest.json").find("\"suite\": \"s\""), std::string::npos);
+  ASSERT_EQ(shell(run_other + " --force"), 0);
+  EXPECT_NE(read(out / "manifest.json").find("\"suite\": \"other\""), std::string::npos);
+}

@@ -1,6 +1,7 @@
 #include "suite.hpp"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -9,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cerrno>
 #include <cstring>
 #include <ctime>
 #include <filesystem>
@@ -834,6 +836,44 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
   fs::create_directories(cases_dir, ec);
   if (ec) {
     if (rank == 0) fmt::print(err, "mpmvv suite: -o {}: cannot create {}: {}\n", dir.string(), cases_dir.string(), ec.message());
+    return finish_mpi(2);
+  }
+  // One suite at a time on a directory: a second would rename the first's
+  // partial files and rewrite its manifest. The lock (flock on DIR/.lock,
+  // held by rank 0 until it exits, not by the cases it starts) is released by
+  // the kernel however the holder ends. A directory that holds another
+  // suite's manifest is refused unless asked (--force).
+  int refused = 0;
+  std::string refusal;
+  if (rank == 0) {
+    const fs::path lock_file = dir / ".lock";
+    const int fd = ::open(lock_file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd < 0) {
+      refused = 1;
+      refusal = fmt::format("-o {}: cannot open {}: {}", dir.string(), lock_file.string(), std::strerror(errno));
+    } else if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+      refused = 1;
+      refusal = fmt::format("-o {}: another mpmvv suite is running in this directory (it holds {}); wait for it, "
+                            "or choose another directory",
+                            dir.string(), lock_file.string());
+    }  // else the descriptor stays open, and the lock held, until this process exits
+    const fs::path manifest = dir / "manifest.json";
+    if (!refused && fs::exists(manifest) && !request.force) {
+      std::smatch m;
+      const std::string text = read_text(manifest);
+      if (std::regex_search(text, m, std::regex("\"suite\": \"((?:[^\"\\\\]|\\\\.)*)\"")) && m[1].str() != suite.name) {
+        refused = 1;
+        refusal = fmt::format("-o {}: the directory holds the results of suite '{}' (its manifest.json); choose "
+                              "another directory, or --force to run '{}' there and replace that manifest",
+                              dir.string(), m[1].str(), suite.name);
+      }
+    }
+  }
+#ifdef MPMVV_HAVE_MPI
+  if (under_mpi) MPI_Bcast(&refused, 1, MPI_INT, 0, MPI_COMM_WORLD);
+#endif
+  if (refused) {
+    if (rank == 0) fmt::print(err, "mpmvv suite: {}\n", refusal);
     return finish_mpi(2);
   }
   if (rank == 0) fs::copy_file(suite.file, dir / "suite.toml", fs::copy_options::overwrite_existing, ec);

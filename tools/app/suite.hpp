@@ -42,6 +42,7 @@ struct SuiteRequest {
   bool quiet = false;
   bool list = false;         // check the suite and print its cases; run nothing
   std::string only;          // a regular expression: run (or list) only the cases whose id it finds; "" all
+  bool force = false;        // run in a directory that holds another suite's results (its manifest is replaced)
 };
 
 // Whether a results file written with configuration `stored` is the run that

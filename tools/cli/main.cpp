@@ -62,6 +62,9 @@ int main(int argc, char** argv) {
                         "run (or list) only the cases whose id this regular expression finds, e.g. 'cells=(300|600)-'; "
                         "the others stay as an earlier run left them (pending, or kept)")
       ->type_name("REGEX");
+  suite_cmd->add_flag("--force", suite.force,
+                      "run in an output directory that holds another suite's results (its manifest is replaced and "
+                      "its cases are no longer listed)");
 
   std::string report_dir, report_out;
   CLI::App* report_cmd = app.add_subcommand(
