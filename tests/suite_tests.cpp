@@ -425,3 +425,26 @@ TEST(SuiteRunner, ADirectoryInUseOrOfAnotherSuiteIsRefused) {
   ASSERT_EQ(shell(run_other + " --force"), 0);
   EXPECT_NE(read(out / "manifest.json").find("\"suite\": \"other\""), std::string::npos);
 }
+
+// A suite killed outright (SIGKILL, which it cannot catch) leaves no case
+// running: each case asked the kernel for SIGTERM when its suite ends.
+TEST(SuiteRunner, CasesEndWithTheirSuite) {
+  const fs::path dir = scratch("orphans");
+  const fs::path suite = write(dir / "s.toml", small_suite(30));
+  const fs::path out = dir / "out";
+  // The pattern's bracket keeps pgrep from finding this shell's own command line.
+  const std::string hung = "'" + (out / "cases/[s]quare-cells=16").string() + "'";
+  const std::string script = "MPMVV_FAULT=hang MPMVV_FAULT_ONLY=cells=16 " + std::string(MPMVV_BINARY) + " suite " +
+                             suite.string() + " -j 3 -q -o " + out.string() +
+                             " > /dev/null 2>&1 & suite=$!; sleep 2; "
+                             "pgrep -f -- " + hung + " > /dev/null && echo started; "
+                             "kill -9 $suite; sleep 1; "
+                             "pgrep -f -- " + hung + " > /dev/null && echo orphan || echo gone";
+  FILE* pipe = ::popen(script.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string said;
+  char buffer[256];
+  while (std::fgets(buffer, sizeof buffer, pipe)) said += buffer;
+  ::pclose(pipe);
+  EXPECT_EQ(said, "started\ngone\n");
+}

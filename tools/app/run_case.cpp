@@ -1,6 +1,7 @@
 #include "run_case.hpp"
 
 #include <signal.h>
+#include <sys/prctl.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -24,6 +25,7 @@
 #include "scene.hpp"
 #include "solver/parallel.hpp"
 #include "solver/time_loop.hpp"
+#include "suite.hpp"
 
 namespace mpmvv::app {
 
@@ -199,6 +201,15 @@ std::string describe_scenes() {
 }
 
 int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
+  // A case a suite started ends with that suite: SIGTERM when the suite's
+  // process ends (it then writes what it computed, marked interrupted, which
+  // a rerun runs again); a suite already gone is not waited for.
+  if (const char* parent = std::getenv(kSuiteParent); parent && *parent) {
+    if (::prctl(PR_SET_PDEATHSIG, SIGTERM) != 0 || std::to_string(::getppid()) != parent) {
+      fmt::print(err, "mpmvv run: the suite that started this case (process {}) has ended\n", parent);
+      return 2;
+    }
+  }
   std::unique_ptr<SceneCase> scene;
   Config config("", {});
   std::string output = request.output;

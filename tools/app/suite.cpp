@@ -723,10 +723,15 @@ pid_t spawn_case(const std::string& exe, const SuiteCase& c, const fs::path& res
   argv.push_back(nullptr);
 
   std::vector<std::string> env_strings;
-  for (char** e = environ; *e; ++e)
-    if (std::string(*e).rfind("OMP_WAIT_POLICY=", 0) != 0) env_strings.emplace_back(*e);
+  for (char** e = environ; *e; ++e) {
+    const std::string entry(*e);
+    if (entry.rfind("OMP_WAIT_POLICY=", 0) != 0 && entry.rfind(std::string(kSuiteParent) + "=", 0) != 0)
+      env_strings.push_back(entry);
+  }
   // Cases share the cores: waiting threads must not spin on them.
   if (passive_wait) env_strings.emplace_back("OMP_WAIT_POLICY=passive");
+  // The case ends with the suite, however the suite ends (run_case.cpp).
+  env_strings.push_back(fmt::format("{}={}", kSuiteParent, ::getpid()));
   std::vector<char*> envp;
   for (std::string& e : env_strings) envp.push_back(e.data());
   envp.push_back(nullptr);

@@ -34,6 +34,11 @@ struct Suite {
 // with the file, line and key of the first mistake. Nothing runs.
 Suite load_suite(const std::string& path);
 
+// The environment variable through which a suite tells each case it starts
+// its process id: the case asks the kernel for SIGTERM when that process ends
+// (a suite killed by SIGKILL leaves no case running).
+inline constexpr const char* kSuiteParent = "MPMVV_SUITE_PARENT";
+
 struct SuiteRequest {
   std::string suite_file;
   std::string output_dir;    // default: results/<suite name>
