@@ -202,7 +202,11 @@ def stored_norm_check(suite):
     for case in suite.cases:
         if case.results is None:
             continue
-        for line in read_probe_lines(case.results_path):
+        try:
+            lines = read_probe_lines(case.results_path)
+        except (OSError, KeyError, ValueError, TypeError):
+            continue  # a damaged probe group: that case is not checked (its figures say why)
+        for line in lines:
             stored = case.results.errors.get("L1_" + line.name)
             if stored is not None:
                 recomputed = norms.probe_line_l1(line.simulated, line.exact)
@@ -217,7 +221,7 @@ def stored_norm_check(suite):
 @dataclass(frozen=True)
 class FigureEntry:
     study: str
-    path: Path
+    path: Path                   # None for a figure left out (the caption says why)
     caption: str
 
 
@@ -687,18 +691,30 @@ def study_figures(suite, study, rows, directory):
     styles = series_styles(all_series)
     quantities = line_quantities(cases)
     pairs = figure_norms(suite, study, cases)
-    entries = [error_figure(study, norm, t, rows, styles, quantities, directory) for norm, t in pairs]
+    entries = []
+
+    def add(make, *args):
+        # A results file damaged where a figure reads it (a missing or
+        # misshapen probe dataset) costs that figure, named with the cause, and
+        # the rest of the report renders.
+        try:
+            entries.append(make(*args))
+        except (OSError, KeyError, ValueError, TypeError, IndexError) as error:
+            entries.append(FigureEntry(study, None, f"{study}: {make.__name__.replace('_', ' ')} left out: a results "
+                                                    f"file could not be read for it ({type(error).__name__}: {error})"))
+
+    for norm, t in pairs:
+        add(error_figure, study, norm, t, rows, styles, quantities, directory)
     if pairs:
         norm = pairs[0][0]
-        entries.append(work_precision_figure(study, all_series, norm, norms.norm_unit(norm, quantities), styles,
-                                             directory))
-    entries.append(stability_figure(study, all_series, directory))
-    entries.append(health_figure(study, all_series, directory))
-    entries.append(profile_figure(study, all_series, directory))
-    entries.append(history_figure(study, all_series, directory))
-    entries.append(contact_pressure_figure(study, all_series, directory))
-    entries.append(load_approach_figure(study, all_series, directory))
-    entries.append(spectrum_figure(study, all_series, styles, directory))
+        add(work_precision_figure, study, all_series, norm, norms.norm_unit(norm, quantities), styles, directory)
+    add(stability_figure, study, all_series, directory)
+    add(health_figure, study, all_series, directory)
+    add(profile_figure, study, all_series, directory)
+    add(history_figure, study, all_series, directory)
+    add(contact_pressure_figure, study, all_series, directory)
+    add(load_approach_figure, study, all_series, directory)
+    add(spectrum_figure, study, all_series, styles, directory)
     return [e for e in entries if e is not None]
 
 
@@ -988,6 +1004,9 @@ def render_html(report):
     for study in dict.fromkeys(e.study for e in report.figures):
         parts.append(f"<h3>{html.escape(study)}</h3>")
         for entry in (e for e in report.figures if e.study == study):
+            if entry.path is None:
+                parts.append(f"<p class='left-out'><em>{html.escape(entry.caption)}</em></p>")
+                continue
             data = base64.b64encode(entry.path.read_bytes()).decode()
             parts.append(f"<figure><img alt='{html.escape(entry.path.name)}' src='data:image/png;base64,{data}'>"
                          f"<figcaption>{html.escape(entry.caption)}</figcaption></figure>")
@@ -1011,6 +1030,9 @@ def render_markdown(report, output_directory):
     for study in dict.fromkeys(e.study for e in report.figures):
         lines += [f"### {study}", ""]
         for entry in (e for e in report.figures if e.study == study):
+            if entry.path is None:
+                lines += [f"_{entry.caption}_", ""]
+                continue
             lines += [f"![{entry.caption}]({entry.path.relative_to(output_directory).as_posix()})", "",
                       f"_{entry.caption}_", ""]
     return "\n".join(lines)
@@ -1031,7 +1053,7 @@ def write_report(directory, output=None):
     written["markdown"].write_text(render_markdown(report, output))
     write_orders_csv(report.order_rows, written["orders"])
     write_gci_csv(report.gci_rows, written["gci"])
-    return written, len(report.figures)
+    return written, sum(e.path is not None for e in report.figures)
 
 
 class _OneLineParser(argparse.ArgumentParser):
@@ -1050,6 +1072,12 @@ def main(argv):
         written, figure_count = write_report(args.directory, args.output)
     except SuiteDirectoryError as error:
         print(f"mpmvv report: {error}", file=sys.stderr)
+        return 2
+    except OSError as error:
+        # A directory it cannot write (read-only, full): one line, not a traceback.
+        where = args.output or str(Path(args.directory) / "report")
+        print(f"mpmvv report: cannot write the report to {where}: {error.strerror or error} "
+              f"({error.filename or where}); choose another place with -o", file=sys.stderr)
         return 2
     for path in written.values():
         print(f"wrote {path}")

@@ -210,6 +210,11 @@ def read_case_results(path):
         if errors_group is not None:
             error_times = np.asarray(errors_group["time"][:], float) if "time" in errors_group else np.zeros(0)
             errors = {name: np.asarray(errors_group[name][:], float) for name in errors_group if name != "time"}
+            # One value per output time (reports/results-format.md); anything else is a damaged file.
+            for name, values in [("time", error_times)] + list(errors.items()):
+                if values.ndim != 1 or values.shape != error_times.shape:
+                    raise ValueError(f"/errors/{name} has shape {values.shape}, not one value per output time "
+                                     f"{error_times.shape}")
         line_quantities = {}
         for name, group in f.get("probes", {}).items():
             quantity = _plain(group.attrs.get("quantity", ""))

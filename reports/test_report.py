@@ -83,6 +83,31 @@ def test_report_survives_a_damaged_results_file_and_a_missing_suite_file(tmp_pat
     assert "unreadable results file" in page
 
 
+def test_report_survives_misshapen_errors_missing_probes_and_an_unwritable_place(tmp_path, capsys):
+    """Requirement: a results file whose /errors column is 2-D is listed as
+    unreadable with the shape; one whose probe line lost a dataset costs only
+    the figures that read it, each named with the cause; a place the report
+    cannot be written is one line and exit 2. No traceback."""
+    import h5py
+    directory = write_suite_directory(tmp_path / "suite", SYNTHETIC_SUITE, synthetic_ring_cases())
+    with h5py.File(directory / "cases" / "ring-method=cpdi-cells=64.h5", "r+") as f:
+        column = f["errors/L1_theta0"][:]
+        del f["errors/L1_theta0"]
+        f["errors/L1_theta0"] = np.stack([column, column])
+    with h5py.File(directory / "cases" / "ring-method=cpdi-cells=128.h5", "r+") as f:
+        del f["probes/theta0/exact_angular_displacement"]
+    written, figure_count = render(directory, tmp_path / "out")
+    page = written["html"].read_text()
+    assert "unreadable results file (/errors/L1_theta0 has shape (2, 3)" in page
+    assert "profile figure left out: a results file could not be read for it (KeyError" in page
+    assert figure_count > 0
+    blocker = tmp_path / "a-file"
+    blocker.write_text("not a directory")
+    assert report.main([str(directory), "-o", str(blocker / "report")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("mpmvv report: cannot write the report to") and err.count("\n") == 1
+
+
 def test_report_exit_2_for_a_directory_that_is_not_a_suite(tmp_path, capsys):
     """Requirement: one clear line and exit 2 for a missing manifest."""
     assert report.main([str(tmp_path)]) == 2
