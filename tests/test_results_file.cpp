@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include "solver/io/hdf5.hpp"
@@ -185,4 +187,23 @@ TEST(ResultsFile, RunStoppedBySignalWritesWhatItHasAsInterrupted) {
   std::vector<hsize_t> dims;
   const std::vector<double> times = root.open_group("errors").read_doubles("time", &dims);
   for (double t : times) EXPECT_LE(t, reached);
+}
+
+// A case that cannot fit in the machine's memory is refused before anything
+// is allocated, with one line naming the keys (exit 2, no results file); a
+// thread count beyond 1024 is refused by the command line.
+TEST(ResultsFile, ACaseThatCannotFitIsRefusedBeforeItStarts) {
+  const fs::path out = scratch("too-big.h5"), message = scratch("too-big.txt");
+  const std::string command = std::string(MPMVV_BINARY) + " run " + MPMVV_SOURCE_DIR +
+                              "/suites/scenes/ring.toml -q -t 1 --set cells=20000 -o " + out.string() + " > " +
+                              message.string() + " 2>&1";
+  const int status = std::system(command.c_str());
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 2);
+  std::ifstream in(message);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("cells = 20000, particles_per_direction = 2 and threads = 1 need about"), std::string::npos)
+      << text;
+  EXPECT_NE(text.find("use fewer cells, particles per direction or threads"), std::string::npos) << text;
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_EQ(run_mpmvv("-t 100000 --set cells=32 --set end_time=0.01 -o " + scratch("threads.h5").string()), 2);
 }

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <new>
 #include <stdexcept>
 #include <filesystem>
 #include <fstream>
@@ -262,6 +263,11 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
   } catch (const std::invalid_argument& e) {
     // The solver refuses a model it cannot step (make_stepper's checks).
     fmt::print(err, "mpmvv run: {}: the solver refuses the seeded model: {}\n", request.scene_file, e.what());
+    return 2;
+  } catch (const std::bad_alloc&) {
+    // What the estimate before the run let through (refuse_what_cannot_fit).
+    fmt::print(err, "mpmvv run: {}: out of memory ({} threads): use fewer cells, particles per direction or "
+               "threads\n", request.scene_file, max_threads());
     return 2;
   }
 

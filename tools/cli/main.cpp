@@ -39,7 +39,7 @@ int main(int argc, char** argv) {
       ->allow_extra_args(false)
       ->type_name("KEY=VALUE");
   run_cmd->add_option("-o,--output", run.output, "results file (.h5); default: <scene name>.h5")->type_name("FILE");
-  run_cmd->add_option("-t,--threads", run.threads, "OpenMP threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  run_cmd->add_option("-t,--threads", run.threads, "OpenMP threads (default: all cores)")->check(CLI::Range(0, 1024));
   run_cmd->add_flag("-q,--quiet", run.quiet, "no configuration echo and no progress line");
   run_cmd->add_flag("--describe", run.describe, "print every key of the scene with its value and meaning, then stop");
 
