@@ -11,12 +11,6 @@ namespace mpmvv::app {
 
 namespace {
 
-const std::vector<double>* find_column(const ErrorTable& errors, const std::string& name) {
-  for (const auto& [n, values] : errors.columns)
-    if (n == name) return &values;
-  return nullptr;
-}
-
 // A norm relative to the exact signal (the time-integrated one, the scenes'
 // error_* columns) is 0 / 0 where that signal is zero (the ring's cosine
 // motion at t = 0 and 1 s): not a number without anything lost. Every
@@ -29,8 +23,8 @@ bool relative_norm(const std::string& name) {
 
 RunHealth judge_health(const std::vector<HealthSample>& samples, const ErrorTable& errors, const HealthRules& rules,
                        double motion_between_outputs) {
-  const std::vector<double>* error = find_column(errors, "particle_L2");
-  const std::vector<double>* exact = find_column(errors, "exact_displacement_L2");
+  const std::vector<double>* error = errors.find("particle_L2");
+  const std::vector<double>* exact = errors.find("exact_displacement_L2");
   // The whole motion: the largest RMS exact displacement at any time sampled.
   double motion = motion_between_outputs;
   if (exact)

@@ -184,9 +184,14 @@ TimeLoopOptions time_loop_options(const Config& c) {
   return o;
 }
 
-const std::vector<double>& ErrorTable::column(const std::string& name) const {
+const std::vector<double>* ErrorTable::find(const std::string& name) const {
   for (const auto& [n, values] : columns)
-    if (n == name) return values;
+    if (n == name) return &values;
+  return nullptr;
+}
+
+const std::vector<double>& ErrorTable::column(const std::string& name) const {
+  if (const std::vector<double>* values = find(name)) return *values;
   throw std::out_of_range("no error column '" + name + "'");
 }
 

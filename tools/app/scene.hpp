@@ -24,7 +24,8 @@ struct ErrorTable {
   std::vector<double> time;
   std::vector<std::pair<std::string, std::vector<double>>> columns;
 
-  const std::vector<double>& column(const std::string& name) const;
+  const std::vector<double>& column(const std::string& name) const;  // throws when there is none
+  const std::vector<double>* find(const std::string& name) const;     // null when there is none
   std::vector<double>& add_column(const std::string& name);
 };
 
