@@ -54,14 +54,15 @@ CIRCLE_POINTS = 16
 
 def write_case_results(path, keys, h, errors_at_times, times, status="completed", failure_reason="",
                        failure_time=float("nan"), wall_time_s=1.0, contact_pressure=None, history=None,
-                       measurements=None):
+                       measurements=None, particle_positions=None):
     """A results file with the layout of reports/results-format.md: root attributes
     (every key, h, status, ...), /errors with `errors_at_times` (column -> values at
     `times`), and ring-like probes whose arrays reproduce the L1_theta0 column:
     simulated = exact + that error at every point, so eq. 3.1 gives it back.
     Optionally /probes/contact_pressure (dict of its datasets x, time, pressure,
-    exact_pressure), /probes/history (dict: time and one array per scalar) and
-    /measurements (dict: attribute name -> value)."""
+    exact_pressure), /probes/history (dict: time and one array per scalar),
+    /measurements (dict: attribute name -> value) and /particles/reference_position
+    (N x 2)."""
     end_time = float(keys.get("end_time", RING_TIMES[-1]))
     radius = np.linspace(0.75, 1.25, PROBE_POINTS)
     angle = np.linspace(0.0, 2.0 * np.pi, CIRCLE_POINTS, endpoint=False)
@@ -109,13 +110,15 @@ def write_case_results(path, keys, h, errors_at_times, times, status="completed"
                     group[dataset] = np.asarray(values, float)
         if measurements is not None:
             f.create_group("measurements").attrs.update(measurements)
+        if particle_positions is not None:
+            f.create_group("particles")["reference_position"] = np.asarray(particle_positions, float)
 
 
 def write_suite_directory(directory, suite_toml, cases):
     """DIR/suite.toml, DIR/manifest.json and DIR/cases/<id>.{h5,json} (suites/README.md).
     cases: dicts with id, study, keys, status and, for cases that ran, h, errors,
     times (and optionally failure_reason, failure_time, contact_pressure, history,
-    measurements: see write_case_results)."""
+    measurements, particle_positions: see write_case_results)."""
     directory.mkdir(parents=True, exist_ok=True)
     (directory / "cases").mkdir(exist_ok=True)
     (directory / "suite.toml").write_text(suite_toml)
@@ -129,7 +132,8 @@ def write_suite_directory(directory, suite_toml, cases):
                                failure_reason=case.get("failure_reason", ""),
                                failure_time=case.get("failure_time", float("nan")),
                                contact_pressure=case.get("contact_pressure"), history=case.get("history"),
-                               measurements=case.get("measurements"))
+                               measurements=case.get("measurements"),
+                               particle_positions=case.get("particle_positions"))
         (directory / "cases" / f"{case['id']}.json").write_text(json.dumps(entry))
         entries.append(entry)
     (directory / "manifest.json").write_text(json.dumps({"suite": "synthetic", "suite_file": "suites/synthetic.toml",
@@ -244,3 +248,58 @@ def hertz_cases(history=True, contact_pressure=True, measurements=True):
                                     "approach": 2e-4}
         cases.append(case)
     return cases
+
+
+ROUNDOFF_SUITE = """description = "synthetic: errors at round-off beside errors that are small but far above it"
+
+[[study]]
+name = "roundoff"
+scene = "scenes/ring.toml"
+sweep = { cells = [32, 64, 128] }
+
+[[study]]
+name = "small"
+scene = "scenes/ring.toml"
+sweep = { cells = [32, 64, 128] }
+"""
+ROUNDOFF_L1 = (4e-13, 1e-13, 2.5e-14)        # rad: falls as h^2, but below 64 cells within the floor
+
+
+def roundoff_cases():
+    """Two studies on 32, 64, 128 cells, 100 steps each (write_case_results), whose
+    errors fall exactly as h^2. `roundoff`: L1_theta0 errors ROUNDOFF_L1 on the
+    ring-like line, whose mean |exact| is 0.574 rad at t = 1 and whose angles give
+    M = pi: the round-off floor (256 + 100) eps pi = 2.48e-13 rad, 4.3e-13 of the
+    signal, holds the 64- and 128-cell errors; particle_L2 follows the same law in m
+    on a body 1 m across moved 1e-6 m (floor 7.9e-14 m: the 128-cell error).
+    `small`: the same absolute particle_L2 errors on a body 1e-9 m across moved
+    1e-11 m (0.04 to 0.0025 of the signal; floor 7.9e-23 m), and
+    error_axial_stress 1e-9, 2.5e-10, 6.25e-11 (floor 7.9e-14): small, but far above
+    what rounding can leave."""
+    cases = []
+    for study, size, displacement in (("roundoff", 1.0, 1e-6), ("small", 1e-9, 1e-11)):
+        for cells, error in zip((32, 64, 128), ROUNDOFF_L1):
+            keys = {"method": "cpdi", "cells": cells, "end_time": 1.0, "output_times": RING_TIMES}
+            positions = np.array([[0.0, 0.0], [size, 0.0], [0.0, size], [0.6 * size, 0.8 * size]])
+            errors = {"particle_L2": [error] * 3, "exact_displacement_L2": [displacement] * 3}
+            if study == "roundoff":
+                errors["L1_theta0"] = [error] * 3
+            else:
+                errors["error_axial_stress"] = [1e-9 * (32 / cells) ** 2] * 3
+            cases.append({"id": f"{study}-cells={cells}", "study": study, "keys": keys, "status": "completed",
+                          "h": 3.0 / cells, "times": RING_TIMES, "errors": errors, "particle_positions": positions})
+    return cases
+
+
+def record_calls(monkeypatch, module, name):
+    """Replaces the figure function `module.name(curves, title, ...)` with one that
+    records the curves it is handed, by figure title, and still draws them; returns
+    that record."""
+    calls = {}
+    original = getattr(module, name)
+
+    def record(curves, title, *args, **kwargs):
+        calls[title] = curves
+        return original(curves, title, *args, **kwargs)
+    monkeypatch.setattr(module, name, record)
+    return calls

@@ -2,7 +2,9 @@
 """Convergence table of ring results files: the L1 error of eq. 3.1
 (000_1dbcb8acb6dddab9.txt) on each probe line and the volume-weighted particle
 L1 at every output time, against the cell size h, with the observed order
-p = log(E_coarse / E_fine) / log(h_coarse / h_fine) between consecutive meshes.
+p = log(E_coarse / E_fine) / log(h_coarse / h_fine) between consecutive meshes,
+or "round-off" in its place when either error is at round-off (reports/orders.py:
+rounding alone can explain it, and the ratio measures the rounding).
 
 Usage: /usr/bin/python3 reports/convergence_table.py RESULTS.h5 [RESULTS.h5 ...]
 """
@@ -10,6 +12,13 @@ import math
 import sys
 
 import h5py
+
+from results import read_results_file
+from series import error_at_roundoff
+
+# The /errors columns tabulated, by their heading.
+NORMS = {"L1 Theta=0": "L1_theta0", "L1 +45": "L1_theta_plus45", "L1 -45": "L1_theta_minus45",
+         "particle L1": "particle_L1"}
 
 
 def read_case(path):
@@ -25,12 +34,8 @@ def read_case(path):
             "failure_reason": f.attrs["failure_reason"],
             "wall": float(f.attrs["wall_time_s"]),
             "time": list(errors["time"][:]),
-            "norms": {
-                "L1 Theta=0": list(errors["L1_theta0"][:]),
-                "L1 +45": list(errors["L1_theta_plus45"][:]),
-                "L1 -45": list(errors["L1_theta_minus45"][:]),
-                "particle L1": list(errors["particle_L1"][:]),
-            },
+            "norms": {heading: list(errors[column][:]) for heading, column in NORMS.items()},
+            "case": read_results_file(path),
         }
 
 
@@ -38,6 +43,13 @@ def observed_order(e_coarse, e_fine, h_coarse, h_fine):
     if e_coarse <= 0 or e_fine <= 0:
         return float("nan")
     return math.log(e_coarse / e_fine) / math.log(h_coarse / h_fine)
+
+
+def order_cell(coarse, fine, heading, time, e_coarse, e_fine):
+    """The observed order between two meshes, or "round-off" when either error is at round-off."""
+    if any(error_at_roundoff(c["case"], NORMS[heading], time, e) for c, e in ((coarse, e_coarse), (fine, e_fine))):
+        return f"{'round-off':>9}"
+    return f"{observed_order(e_coarse, e_fine, coarse['h'], fine['h']):>9.2f}"
 
 
 def main(paths):
@@ -53,13 +65,13 @@ def main(paths):
     for norm in cases[0]["norms"]:
         print(f"\n{norm} (rad for probe lines, m for particles); order p between consecutive meshes")
         header = f"{'t [s]':>7}" + "".join(f" {'h=' + format(c['h'], '.4g'):>12}" for c in cases)
-        header += "".join(f" {'p':>6}" for _ in cases[1:])
+        header += "".join(f" {'p':>9}" for _ in cases[1:])
         print(header)
         for k, t in enumerate(times):
             values = [c["norms"][norm][k] if k < len(c["time"]) else float("nan") for c in cases]
             row = f"{t:>7.3g}" + "".join(f" {v:>12.4e}" for v in values)
             for a, b in zip(range(len(cases) - 1), range(1, len(cases))):
-                row += f" {observed_order(values[a], values[b], cases[a]['h'], cases[b]['h']):>6.2f}"
+                row += " " + order_cell(cases[a], cases[b], norm, t, values[a], values[b])
             print(row)
     return 0
 

@@ -18,6 +18,9 @@ An error that behaves as E(h) = C h^p on meshes of cell size h has
 Classification of a range (the rule, applied in this order):
 
 * ``too few levels``: fewer than two usable levels;
+* ``round-off``: the error of some usable level is positive and at most its
+  round-off floor (below): rounding alone can explain it, so the levels' ratios
+  measure the rounding, not the method, and no order is given;
 * ``stalled``: the last pairwise order (between the two finest levels) is below
   STALLED_BELOW = 0.5: the error no longer falls with h;
 * ``non-asymptotic``: the pairwise orders span more than ASYMPTOTIC_SPREAD = 0.5
@@ -26,6 +29,29 @@ Classification of a range (the rule, applied in this order):
 * ``unchecked (2 levels)``: one pairwise order only, not stalled; nothing to
   compare it with;
 * ``asymptotic`` otherwise.
+
+The round-off floor of an error that is a difference of numbers of size M
+(a displacement error x_p - x_exact(X_p, t) is one of positions, so M is the
+largest |X| of the points it is read at, the body's size, not the displacement's;
+pi for an angle; 1 for an error relative to its exact value) after a run of n
+steps is
+
+    (ROUNDOFF_ULPS + n) eps M,      eps = 2.2e-16, the spacing of doubles at 1:
+
+each step rounds the positions again (x <- x + dt v), by up to one ulp of M, and
+in the worst case the roundings add up, n eps M; ROUNDOFF_ULPS = 256 more ulps
+cover what does not accumulate: forming the exact solution at the point (a few
+elementary functions, each good to an ulp or two), the difference and the norm.
+Divided by the exact signal S the norm measures at the read time (the mean
+|exact| on a probe line, the RMS exact displacement, 1 for a relative error), it
+is the smallest relative error E / S an order can be observed from. It is a
+worst case (independent roundings mostly cancel, leaving nearer sqrt(n) ulps
+than n): an error above it is not this rounding; one at or below it may be, and an
+order fitted through it is no evidence of how the method converges. For a
+relative error M = 1, but a strain formed as F - I near F = I (and a stress
+formed from it) is rounded to ulps of 1, not of the strain: for the error_*
+columns of a strain or stress M = 1 / |strain|, the largest |F - I| entry
+of the particles (results.py: error_scale).
 
 Richardson extrapolation and the grid convergence index (Roache, *Verification
 and Validation in Computational Science and Engineering*, 1998, ch. 5; Roache,
@@ -47,11 +73,16 @@ h_medium/h_fine, values f_3 (coarse), f_2 (medium), f_1 (fine):
   asymptotic range.
 """
 import math
+import sys
 from dataclasses import dataclass
 
 STALLED_BELOW = 0.5
 ASYMPTOTIC_SPREAD = 0.5
 GCI_SAFETY_FACTOR = 1.25
+# Ulps of the numbers an error is a difference of that do not accumulate with
+# the steps (the exact solution's elementary functions, the difference, the
+# norm): "a few hundred", generous, so that the floor is a worst case.
+ROUNDOFF_ULPS = 256
 
 
 def pairwise_orders(h, error):
@@ -101,11 +132,20 @@ def least_squares_order(h, error, confidence=0.95):
     return OrderFit(slope, math.exp(intercept), slope - half_width, slope + half_width, confidence, n)
 
 
-def classify(pairwise):
-    """The class of a refinement range from its pairwise orders (rule in the module docstring)."""
+def roundoff_floor(steps, size):
+    """(ROUNDOFF_ULPS + steps) eps size: the largest error rounding alone can leave
+    in a difference of numbers of the given size after that many steps (module docstring)."""
+    return (ROUNDOFF_ULPS + max(steps, 0)) * sys.float_info.epsilon * size
+
+
+def classify(pairwise, roundoff=False):
+    """The class of a refinement range from its pairwise orders and whether some
+    level's error is at round-off (rule in the module docstring)."""
     finite = [p for p in pairwise if math.isfinite(p)]
     if not pairwise or not finite:
         return "too few levels"
+    if roundoff:
+        return "round-off"
     if not math.isfinite(pairwise[-1]) or pairwise[-1] < STALLED_BELOW:
         return "stalled"
     if len(finite) < 2:
@@ -184,7 +224,7 @@ def richardson_extrapolate(fine, coarse, ratio, order):
 class GridConvergence:
     """Roache's three-level study of a quantity (definitions in the module docstring)."""
     observed_order: float
-    convergence: str           # monotone | oscillatory | divergent | converged
+    convergence: str           # monotone | oscillatory | divergent | converged (report.py: or round-off)
     extrapolated: float
     gci_fine: float            # relative: multiply by |f_fine| for a band in the quantity's unit
     gci_medium: float

@@ -36,7 +36,8 @@ import orders
 import references
 from results import (SuiteDirectoryError, lookup_error, read_contact_pressure, read_error_spectrum, read_monitors,
                      read_point_history, read_probe_lines, read_scene_history, read_suite, relative_energy_created)
-from series import DEFAULT_REFINE_KEY, refined_size, refinement_series, series_levels, size_name, usable
+from series import (DEFAULT_REFINE_KEY, at_roundoff, refined_size, refinement_series, roundoff_checks,
+                    roundoff_text, series_levels, size_name, usable)
 
 ORDERS_CSV_COLUMNS = (
     ("study", "the study"),
@@ -49,15 +50,20 @@ ORDERS_CSV_COLUMNS = (
     ("h", "the size the refine key sets at those levels: cell size h [m]; h / particles_per_direction [m] for "
           "particles per direction; cfl h [m] for cfl; 1 / load_steps (reports/series.py: REFINED_SIZES)"),
     ("error", "the norm at those levels"),
-    ("pairwise_orders", "orders between consecutive usable levels"),
-    ("ls_order", "least-squares order"),
-    ("ci_low", "lower end of its 95% Student-t interval (NaN with two levels)"),
+    ("pairwise_orders", "orders between consecutive usable levels (empty at round-off)"),
+    ("ls_order", "least-squares order (NaN at round-off)"),
+    ("ci_low", "lower end of its 95% Student-t interval (NaN with two levels or at round-off)"),
     ("ci_high", "upper end"),
-    ("classification", "asymptotic, non-asymptotic, stalled, unchecked (2 levels) or too few levels"),
+    ("classification", "round-off, asymptotic, non-asymptotic, stalled, unchecked (2 levels) or too few levels"),
     ("finest_level", "refine value of the finest usable level"),
     ("finest_h", "its size (as h)"),
     ("finest_error", "its error"),
     ("left_out", "levels without a usable value at that time, and why"),
+    ("relative_error", "each usable level's error over the exact signal the norm measures at that time (NaN where "
+                       "not known; error_* and particle_relative_L2_integrated are relative already: signal 1)"),
+    ("roundoff_floor", "each usable level's round-off floor, (256 + steps) ulps of the numbers the error is a "
+                       "difference of, over the same signal: a level whose relative_error is at most this is at "
+                       "round-off (reports/orders.py)"),
 )
 METHOD_KEYS = ("method", "scheme", "particles_per_direction", "cfl", "time_integration", "solver", "load_steps",
                "dilatation", "formulation")
@@ -82,6 +88,12 @@ class OrderRow:
     pairwise: tuple
     fit: orders.OrderFit
     classification: str
+    roundoff: tuple = ()         # series.RoundOff per usable level (None where its signal is not known)
+
+    @property
+    def has_order(self):
+        """False for a series at round-off: its fitted numbers measure the rounding."""
+        return self.classification != "round-off"
 
 
 @dataclass(frozen=True)
@@ -136,9 +148,11 @@ def order_row(series, norm, unit, time, at_end):
     good = usable(levels)
     h, error = [l.h for l in good], [l.error for l in good]
     pairwise = orders.pairwise_orders(h, error)
+    checks = roundoff_checks(good, norm, time) if len(good) >= 2 else []
     return OrderRow(series.study, series, norm, unit, time, at_end, tuple(good),
                     tuple(l for l in levels if l.reason), tuple(pairwise),
-                    orders.least_squares_order(h, error), orders.classify(pairwise))
+                    orders.least_squares_order(h, error), orders.classify(pairwise, bool(at_roundoff(checks))),
+                    tuple(checks))
 
 
 def order_rows(suite):
@@ -189,10 +203,31 @@ def gci_row(series):
     fine = histories[-1]
     at = float(max(output_times, key=lambda t: abs(np.interp(t, fine.time, fine.simulated))))
     values = tuple(float(np.interp(at, h.time, h.simulated)) for h in histories)
+    convergence = orders.grid_convergence(values[0], values[1], values[2], ratio)
+    if point_changes_at_roundoff(finest, fine, values):
+        nan = float("nan")
+        convergence = orders.GridConvergence(nan, "round-off", nan, nan, nan, nan)
     return GciRow(series.study, series, fine.name, fine.quantity, at,
-                  tuple(c.keys[series.refine] for c in finest), values, ratio,
-                  orders.grid_convergence(values[0], values[1], values[2], ratio),
+                  tuple(c.keys[series.refine] for c in finest), values, ratio, convergence,
                   float(np.interp(at, fine.time, fine.exact)))
+
+
+def point_changes_at_roundoff(cases, history, values):
+    """True when a change of the point's value between consecutive levels is no
+    larger than the round-off floor of reports/orders.py (the point's |X| for a
+    length, pi for an angle, over the most steps any of the cases took): such
+    changes measure rounding, and Roache's order of them means nothing."""
+    position = np.ravel(np.asarray(history.reference_position, float))
+    if history.quantity == "angular_displacement":
+        size = math.pi
+    elif position.size >= 2 and np.all(np.isfinite(position[:2])):
+        size = float(np.hypot(position[0], position[1]))
+    else:
+        return False
+    steps = [c.attribute("steps", 0) for c in cases]
+    steps = max((int(n) for n in steps if isinstance(n, (int, float)) and math.isfinite(n)), default=0)
+    floor = orders.roundoff_floor(steps, size)
+    return any(abs(coarse - fine) <= floor for coarse, fine in zip(values, values[1:]))
 
 
 def stored_norm_check(suite):
@@ -275,8 +310,10 @@ def error_figure(study, norm, time, rows, styles, quantities, directory):
         return None
     times = sorted({r.time for r in chosen})
     when = time_text(times[0]) if len(times) == 1 else "the end time"
-    curves = [figures.Curve(r.series.label, [l.h for l in r.levels], [l.error for l in r.levels],
-                            styles[r.series.label], r.fit) for r in chosen]
+    # A series at round-off is drawn without a fit, and its legend says why.
+    curves = [figures.Curve(r.series.label if r.has_order else f"{r.series.label}: round-off, no order",
+                            [l.h for l in r.levels], [l.error for l in r.levels], styles[r.series.label],
+                            r.fit if r.has_order else None) for r in chosen]
     unit = chosen[0].unit
     against = size_name(chosen[0].series.refine)
     figure = figures.error_against_h(curves, f"{study}: {norm} at {when}", f"{norm} [{unit}]", against)
@@ -285,6 +322,10 @@ def error_figure(study, norm, time, rows, styles, quantities, directory):
     missing = [r.series.label for r in chosen if not r.levels]
     caption = (f"{study}: {norms.describe_norm(norm, quantities)} [{unit}] at {when} against {against}; "
                f"dashed: least-squares fit; grey: slopes 1 and 2.")
+    at_floor = [r for r in chosen if not r.has_order]
+    if at_floor:
+        caption += " No order, errors at round-off: " + "; ".join(
+            f"{r.series.label} {roundoff_text(r.series.refine, r.roundoff)}" for r in at_floor) + "."
     if missing:
         caption += f" No usable level: {'; '.join(missing)}."
     return FigureEntry(study, path, caption)
@@ -822,12 +863,13 @@ def order_cells(row):
     fit = row.fit
     ci = f" [{fit.ci_low:.2f}, {fit.ci_high:.2f}]" if math.isfinite(fit.ci_low) else ""
     finest = row.levels[-1] if row.levels else None
+    shown = row.has_order and math.isfinite(fit.order)
     return [row.study, row.series.label, f"{row.norm} [{row.unit}]", f"{row.time:g}",
             ", ".join(str(l.value) for l in row.levels) or "-",
             number(finest.error) if finest else "-",
-            ", ".join(number(p, ".2f") for p in row.pairwise) or "-",
-            (number(fit.order, ".3f") + ci) if math.isfinite(fit.order) else "-",
-            row.classification]
+            (", ".join(number(p, ".2f") for p in row.pairwise) if row.has_order else "") or "-",
+            (number(fit.order, ".3f") + ci) if shown else "-",
+            row.classification if row.has_order else f"round-off {roundoff_text(row.series.refine, row.roundoff)}"]
 
 
 def orders_table(rows):
@@ -846,7 +888,8 @@ def gci_table(rows):
                       ", ".join(str(v) for v in r.levels), ", ".join(number(v, ".6g") for v in r.values),
                       number(g.observed_order, ".2f"), g.convergence, number(g.extrapolated, ".6g"),
                       number(100 * g.gci_fine, ".3g"), number(g.asymptotic_ratio, ".3f"),
-                      number(r.exact, ".6g"), "yes" if error <= band else "no"])
+                      number(r.exact, ".6g"),
+                      "-" if g.convergence == "round-off" else "yes" if error <= band else "no"])
     return Table(["study", "series", "quantity", "t [s]", "levels", "values (coarse to fine)", "observed p",
                   "convergence", "extrapolated", "GCI fine [%]", "asymptotic ratio", "exact (check)",
                   "exact within GCI band"], cells)
@@ -861,6 +904,14 @@ def _joined(values):
     return ";".join(repr(float(v)) for v in values)
 
 
+def _per_level(row, value):
+    """value(check) for each usable level of the row, NaN where its exact signal is not known
+    (and for a row of fewer than two levels, which is not checked)."""
+    if len(row.roundoff) != len(row.levels):
+        return [float("nan")] * len(row.levels)
+    return [float("nan") if c is None else value(c) for c in row.roundoff]
+
+
 def write_orders_csv(rows, path):
     with open(path, "w", newline="") as stream:
         writer = csv.writer(stream)
@@ -869,11 +920,14 @@ def write_orders_csv(rows, path):
             finest = r.levels[-1] if r.levels else None
             writer.writerow([r.study, r.series.label, r.norm, r.unit, repr(r.time), r.series.refine,
                              ";".join(str(l.value) for l in r.levels), _joined(l.h for l in r.levels),
-                             _joined(l.error for l in r.levels), _joined(r.pairwise), repr(r.fit.order),
-                             repr(r.fit.ci_low), repr(r.fit.ci_high), r.classification,
-                             finest.value if finest else "", repr(finest.h) if finest else "",
+                             _joined(l.error for l in r.levels), _joined(r.pairwise) if r.has_order else "",
+                             *(repr(v if r.has_order else float("nan")) for v in (r.fit.order, r.fit.ci_low,
+                                                                                   r.fit.ci_high)),
+                             r.classification, finest.value if finest else "", repr(finest.h) if finest else "",
                              repr(finest.error) if finest else "",
-                             ";".join(f"{l.value}: {l.reason}" for l in r.left_out)])
+                             ";".join(f"{l.value}: {l.reason}" for l in r.left_out),
+                             _joined(_per_level(r, lambda c: c.relative_error)),
+                             _joined(_per_level(r, lambda c: c.relative_floor))])
 
 
 def write_gci_csv(rows, path):
@@ -918,10 +972,13 @@ DEFINITIONS = (
     "maximum of the particle displacement error |x_p - x_exact(X_p, t)|; particle_relative_L2_integrated is "
     "sqrt(int sum V_p0 e_p^2 dt / int sum V_p0 |x_exact - X_p|^2 dt) from t = 0 (reports/norms.py). Orders: pairwise "
     "p = ln(E_i/E_i+1)/ln(h_i/h_i+1) between consecutive usable levels; least-squares slope of ln E against ln h with "
-    "a 95% Student-t interval (none with two levels). Class: stalled when the finest pairwise order is below "
-    f"{orders.STALLED_BELOW}; non-asymptotic when the pairwise orders span more than {orders.ASYMPTOTIC_SPREAD}; "
-    "unchecked with one pair; asymptotic otherwise. A level is usable when its case wrote the norm at that time "
-    "(a failed run keeps the outputs it reached).")
+    "a 95% Student-t interval (none with two levels). Class: round-off when some level's error is positive and at "
+    f"most its round-off floor, ({orders.ROUNDOFF_ULPS} + steps) ulps of the numbers the error is a difference of "
+    "(the body's coordinates for a displacement, not the displacement; 1 for a relative error): rounding alone "
+    "can explain it, and no order is given (the error over the exact signal it measures is shown); stalled when "
+    f"the finest pairwise order is below {orders.STALLED_BELOW}; non-asymptotic when the pairwise orders span more "
+    f"than {orders.ASYMPTOTIC_SPREAD}; unchecked with one pair; asymptotic otherwise. A level is usable when its "
+    "case wrote the norm at that time (a failed run keeps the outputs it reached).")
 
 
 def build_report(suite, figure_directory):
@@ -946,7 +1003,9 @@ def build_report(suite, figure_directory):
                      "Roache's GCI (safety factor 1.25) of the point probe's simulated value on the three finest "
                      "completed levels of each series with a constant refinement ratio, at the output time where the "
                      "finest value is largest in magnitude, treated as a quantity without an exact value; the exact "
-                     "value is shown only to check the band f_fine (1 +- GCI).", gci_table(grid_rows)))
+                     "value is shown only to check the band f_fine (1 +- GCI). Convergence round-off: a change between "
+                     f"two levels is at most ({orders.ROUNDOFF_ULPS} + steps) ulps of the point's |X| (pi for an "
+                     "angle), which rounding alone can explain: no order, extrapolation or GCI.", gci_table(grid_rows)))
     entries = [e for study in suite.study_names() for e in study_figures(suite, study, rows, figure_directory)]
     return Report(suite, datetime.now(), status_counts(suite), stored_norm_check(suite), rows, grid_rows,
                   sections, entries)

@@ -18,7 +18,8 @@ import json
 import math
 from dataclasses import dataclass
 
-from results import lookup_error
+from orders import roundoff_floor
+from results import error_scale, lookup_error
 
 DEFAULT_REFINE_KEY = "cells"
 
@@ -169,3 +170,63 @@ def series_levels(series, norm, time=None, levels=None):
 
 def usable(levels):
     return [level for level in levels if not level.reason]
+
+
+@dataclass(frozen=True)
+class RoundOff:
+    """A usable level's error beside the exact signal it measures at the read time
+    and the largest error rounding alone can leave there (reports/orders.py)."""
+    level: Level
+    signal: float         # S, in the norm's unit (1 for an error relative to its exact value)
+    floor: float          # orders.roundoff_floor(the case's steps, M)
+
+    @property
+    def relative_error(self):
+        return self.level.error / self.signal if self.signal > 0 else float("inf")
+
+    @property
+    def relative_floor(self):
+        return self.floor / self.signal if self.signal > 0 else float("inf")
+
+    @property
+    def at_roundoff(self):
+        # An error of exactly zero is not rounding: the gate asks whether the run measures the norm.
+        return 0.0 < self.level.error <= self.floor
+
+
+def roundoff_checks(levels, norm, time=None):
+    """One RoundOff per usable level of `levels`, in order, at output time `time`
+    (default: the case's end time); None for a level whose exact signal or
+    coordinate size is not known (results.error_scale)."""
+    checks = []
+    for level in usable(levels):
+        case = level.case
+        scale = error_scale(case, norm, case.end_time if time is None else float(time))
+        steps = case.attribute("steps", 0)
+        steps = int(steps) if isinstance(steps, (int, float)) and math.isfinite(steps) else 0
+        checks.append(None if scale is None else RoundOff(level, scale[0], roundoff_floor(steps, scale[1])))
+    return checks
+
+
+def error_at_roundoff(case, norm, time, error):
+    """True when `error`, the case's `norm` at output time `time`, is at round-off
+    (RoundOff), for tables that compare single results files."""
+    [check] = roundoff_checks([Level(case, None, case.h, error, "")], norm, time)
+    return check is not None and check.at_roundoff
+
+
+def at_roundoff(checks):
+    """The checks whose level's error is at round-off."""
+    return [c for c in checks if c is not None and c.at_roundoff]
+
+
+def roundoff_text(refine, checks):
+    """Which levels among `checks` are at round-off and how small their errors are
+    ("at cells=88 (up to 9.4e-08 of the exact signal; round-off floor 9.5e-08)"),
+    for a report cell or a gate reason; "" when none is."""
+    at = at_roundoff(checks)
+    if not at:
+        return ""
+    largest = max(at, key=lambda c: c.relative_error)
+    return (f"at {refine}={','.join(str(c.level.value) for c in at)} (up to {largest.relative_error:.2g} of the "
+            f"exact signal; round-off floor {largest.relative_floor:.2g})")

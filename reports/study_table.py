@@ -2,7 +2,8 @@
 """Status and error of results files, grouped by scene, amplitude, variant and
 method: whether each run completed (or when and why it stopped), its wall
 time, chosen error norms at chosen times, and the observed order between
-consecutive meshes of the same group.
+consecutive meshes of the same group ("round-off" in its place when either
+error is at round-off, reports/orders.py: the ratio measures the rounding).
 
 Usage: /usr/bin/python3 reports/study_table.py [--times 0.25,1.0]
            [--norms L1_theta0,particle_L2] RESULTS.h5 ...
@@ -15,6 +16,9 @@ import sys
 from collections import defaultdict
 
 import h5py
+
+from results import read_results_file
+from series import error_at_roundoff
 
 METHOD_ORDER = {"linear": 0, "gimp": 1, "cpdi": 2, "cpdi-exact": 3, "bspline": 4, "bspline-cubic": 5}
 
@@ -54,6 +58,7 @@ def read_case(path, times, norms):
             "steps": int(attrs["steps"]),
             "columns": [(norm, t) for norm in chosen for t in wanted],
             "values": values,
+            "case": read_results_file(path),
         }
 
 
@@ -62,6 +67,16 @@ def order(coarse, fine, key):
     if a > 0 and b > 0 and coarse["h"] != fine["h"]:
         return math.log(a / b) / math.log(coarse["h"] / fine["h"])
     return float("nan")
+
+
+def order_cell(coarse, fine, key):
+    """The order between two meshes (blank for the first), or "round-off" when either error is at round-off."""
+    if coarse is None:
+        return f"{float('nan'):>9.2f}"
+    norm, time = key
+    if any(error_at_roundoff(c["case"], norm, time, c["values"].get(key, float("nan"))) for c in (coarse, fine)):
+        return f"{'round-off':>9}"
+    return f"{order(coarse, fine, key):>9.2f}"
 
 
 def main(argv):
@@ -83,7 +98,7 @@ def main(argv):
         print(f"\n{label}")
         columns = cases[0]["columns"]
         head = f"{'cells':>6} {'outcome':<34} {'wall [s]':>9} {'forcing':>8} {'steps':>6}"
-        head += "".join(f" {n + ' t=' + format(t, 'g'):>22} {'order':>6}" for n, t in columns)
+        head += "".join(f" {n + ' t=' + format(t, 'g'):>22} {'order':>9}" for n, t in columns)
         print(head)
         previous = None
         for c in cases:
@@ -91,8 +106,7 @@ def main(argv):
             forcing = c["forcing"] / c["wall"] if c["wall"] > 0 else float("nan")
             row = f"{c['cells']:>6} {outcome:<34} {c['wall']:>9.3g} {forcing:>7.0%} {c['steps']:>6}"
             for col in columns:
-                p = order(previous, c, col) if previous else float("nan")
-                row += f" {c['values'].get(col, float('nan')):>22.3e} {p:>6.2f}"
+                row += f" {c['values'].get(col, float('nan')):>22.3e} {order_cell(previous, c, col)}"
             print(row)
             previous = c
     return 0

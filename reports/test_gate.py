@@ -8,13 +8,15 @@ import json
 from dataclasses import replace
 
 import h5py
+import numpy as np
 import pytest
 
 import gate
 import report
-from conftest import RING_TIMES, SYNTHETIC_SUITE, synthetic_ring_cases, write_suite_directory
-from results import read_suite
-from series import refinement_series, series_levels
+from conftest import (RING_TIMES, ROUNDOFF_SUITE, SYNTHETIC_SUITE, roundoff_cases, synthetic_ring_cases,
+                      write_suite_directory)
+from results import error_scale, read_suite
+from series import error_at_roundoff, refinement_series, series_levels
 
 
 def run_gate(directory, capsys):
@@ -405,3 +407,87 @@ def test_orders_against_particles_per_direction_and_the_time_step(tmp_path, caps
     assert status == 1
     series = refinement_series(read_suite(directory).cases_of("markers"), "particles_per_direction")
     assert [l.h for l in series_levels(series[0], "L1_theta0")] == pytest.approx([h, h / 2, h / 4])
+
+
+ROUNDOFF_EXPECTATIONS = """
+[[expect]]
+study = "roundoff"
+norm = "L1_theta0"
+order = 2.0
+tolerance = 0.1
+
+[[expect]]
+study = "roundoff"
+norm = "L1_theta0"
+max_error = 1e-12
+
+[[expect]]
+study = "roundoff"
+norm = "particle_L2"
+order = 2.0
+tolerance = 0.1
+
+[[expect]]
+study = "small"
+norm = "particle_L2"
+order = 2.0
+tolerance = 0.1
+
+[[expect]]
+study = "small"
+norm = "error_axial_stress"
+order = 2.0
+tolerance = 0.1
+"""
+
+
+def test_an_order_of_errors_at_round_off_fails_and_max_error_holds(tmp_path, capsys):
+    """Requirement: an expectation that asks for an order of a series whose errors
+    rounding alone can explain (conftest.roundoff_cases: an exact h^2 law whose 64-
+    and 128-cell L1 errors are within (256 + steps) ulps of pi, whose 128-cell
+    particle_L2 error is within them of the body's 1 m) fails with one reason
+    naming the class, the levels and the error over the exact signal, and shows
+    no fitted order; a max_error expectation on the same errors holds; the same
+    law on a body a billion times smaller, moved a hundred thousand times less,
+    is no round-off and passes (the rule is relative, not absolute)."""
+    directory = write_suite_directory(tmp_path / "suite", ROUNDOFF_SUITE + ROUNDOFF_EXPECTATIONS, roundoff_cases())
+    status, out, _ = run_gate(directory, capsys)
+    rows = {r.split()[0]: r for r in rows_of(out)}
+    assert "FAIL" in rows["1"] and ("errors at round-off at cells=64,128 (up to 1.7e-13 of the exact signal; "
+                                    "round-off floor 4.3e-13): no order can be observed; check max_error instead"
+                                    ) in rows["1"]
+    assert "- (round-off)" in rows["1"] and "2.000" not in rows["1"] and "outside" not in rows["1"]
+    assert "PASS" in rows["2"] and "E = 4e-13 <= 1e-12" in rows["2"]
+    assert "FAIL" in rows["3"] and "errors at round-off at cells=128 (up to 2.5e-08 of the exact signal; " \
+                                   "round-off floor 7.9e-08)" in rows["3"]
+    assert "PASS" in rows["4"] and "2.000 [2.00, 2.00]" in rows["4"]
+    assert "PASS" in rows["5"] and "2.000 [2.00, 2.00]" in rows["5"]
+    assert status == 1 and "2 of 5 expectations fell short" in out
+
+
+def test_a_small_strain_is_rounded_to_ulps_of_one(tmp_path):
+    """Requirement: the relative error of a strain (or a stress formed from one)
+    is rounded to ulps of F's entries, near 1, over the strain: with the largest
+    |F - I| entry 2e-4 and 100 steps its floor is (256 + 100) eps / 2e-4 = 4e-10,
+    so a relative strain error of 1e-11 is at round-off and one of 1e-6 is not;
+    an error_* column of another quantity keeps the floor of the ratio itself."""
+    cases = []
+    for cells in (8, 16):
+        keys = {"method": "cpdi", "cells": cells, "end_time": 1.0, "output_times": RING_TIMES}
+        errors = {"error_axial_strain": [1e-11] * 3, "error_period": [1e-11] * 3}
+        cases.append({"id": f"bar-cells={cells}", "study": "bar", "keys": keys, "status": "completed",
+                      "h": 1.0 / cells, "times": RING_TIMES, "errors": errors})
+    directory = write_suite_directory(tmp_path / "suite", "[[study]]\nname = \"bar\"\nscene = \"scenes/ring.toml\"\n",
+                                      cases)
+    with h5py.File(directory / "cases" / "bar-cells=8.h5", "a") as f:
+        f["particles/deformation_gradient"] = np.array([[[1.0 + 2e-4, 0.0], [0.0, 1.0 - 0.5e-4]]] * 4)
+    by_id = {c.id: c for c in read_suite(directory).cases}
+    case = by_id["bar-cells=8"]
+    assert error_scale(case, "error_axial_strain", 1.0) == pytest.approx((1.0, 1.0 / 2e-4))
+    assert error_at_roundoff(case, "error_axial_strain", 1.0, 1e-11)
+    assert not error_at_roundoff(case, "error_axial_strain", 1.0, 1e-6)
+    assert error_scale(case, "error_period", 1.0) == (1.0, 1.0)
+    assert not error_at_roundoff(case, "error_period", 1.0, 1e-11)
+    # Without F in the file the ratio's own floor, 7.9e-14.
+    assert error_scale(by_id["bar-cells=16"], "error_axial_strain", 1.0) == (1.0, 1.0)
+

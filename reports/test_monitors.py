@@ -14,7 +14,7 @@ import pytest
 
 import figures
 import report
-from conftest import write_case_results
+from conftest import record_calls, write_case_results
 from results import Case, CaseResults, RunMonitors, energy_balance_scale, relative_energy_created
 
 GOLD = Path(__file__).parent / "gold"
@@ -74,14 +74,7 @@ def gold_with_results(directory, monitors_in=()):
 @pytest.fixture
 def drawn(monkeypatch):
     """The curves handed to figures.run_health, by figure title."""
-    calls = {}
-    original = figures.run_health
-
-    def record(curves, title, *args, **kwargs):
-        calls[title] = curves
-        return original(curves, title, *args, **kwargs)
-    monkeypatch.setattr(figures, "run_health", record)
-    return calls
+    return record_calls(monkeypatch, figures, "run_health")
 
 
 needs_gold = pytest.mark.skipif(not (GOLD / "manifest.json").is_file(), reason="reports/gold is not there")

@@ -107,3 +107,16 @@ def test_richardson_and_gci_on_a_known_sequence():
     assert orders.grid_convergence(3.02, 2.99, 3.0, 2.0).convergence == "oscillatory"
     assert orders.grid_convergence(1.0, 2.0, 4.0, 2.0).convergence == "divergent"
     assert abs(orders.richardson_extrapolate(3.0025, 3.01, 2.0, 2.0) - 3.0) < 1e-12
+
+
+def test_a_range_with_a_level_at_round_off_has_no_order_class():
+    """Requirement: the round-off floor is (256 + steps) eps M, and a range with a
+    level at round-off is classified "round-off" whatever its pairwise orders (an
+    exact h^2 law included); without one the rule is as before."""
+    eps = 2.220446049250313e-16
+    assert orders.roundoff_floor(100, math.pi) == pytest.approx(356 * eps * math.pi, rel=1e-15)
+    assert orders.roundoff_floor(0, 0.03) == pytest.approx(256 * eps * 0.03, rel=1e-15)
+    exact_h2 = orders.pairwise_orders(H[:3], [4e-13, 1e-13, 2.5e-14])
+    assert orders.classify(exact_h2, roundoff=True) == "round-off"
+    assert orders.classify(exact_h2) == "asymptotic"
+    assert orders.classify([], roundoff=True) == "too few levels"

@@ -14,8 +14,10 @@ import pytest
 import figures
 import gate
 import report
-from conftest import (HERTZ_END_TIME, HERTZ_SUITE, SYNTHETIC_SUITE, hertz_cases, hertz_exact_pressure,
-                      hertz_half_width, hertz_load, synthetic_ring_cases, write_suite_directory)
+from conftest import (HERTZ_END_TIME, HERTZ_SUITE, ROUNDOFF_SUITE, SYNTHETIC_SUITE, hertz_cases, hertz_exact_pressure,
+                      hertz_half_width, hertz_load, record_calls, roundoff_cases, synthetic_ring_cases,
+                      write_suite_directory)
+from results import PointHistory, read_suite
 
 GOLD = Path(__file__).parent / "gold"
 
@@ -291,3 +293,49 @@ def test_a_reference_the_report_cannot_read_is_said_not_fatal(tmp_path):
     directory = write_suite_directory(tmp_path / "suite", bad, synthetic_ring_cases())
     page = render(directory, tmp_path / "out")[0]["html"].read_text()
     assert "Not shown: [[reference]] 1: needs &#x27;study&#x27; and &#x27;quantity&#x27;" in page
+
+
+def test_report_gives_no_order_for_errors_at_round_off(tmp_path, monkeypatch):
+    """Requirement: a series with a level at round-off (conftest.roundoff_cases)
+    gets the class "round-off" and no order anywhere the report shows orders: "-"
+    in the table with the levels, their error over the exact signal and the floor;
+    an empty pairwise_orders and NaN least-squares order in orders.csv, with each
+    level's relative error and floor; no fitted line and "no order" in the figure
+    legend. The same h^2 law on a small body moved little is no round-off: order 2."""
+    drawn = record_calls(monkeypatch, figures, "error_against_h")
+    directory = write_suite_directory(tmp_path / "suite", ROUNDOFF_SUITE, roundoff_cases())
+    written = render(directory, tmp_path / "out")[0]
+    with open(written["orders"]) as stream:
+        rows = {(r["study"], r["norm"]): r for r in csv.DictReader(stream)}
+    for key in (("roundoff", "L1_theta0"), ("roundoff", "particle_L2")):
+        assert rows[key]["classification"] == "round-off"
+        assert rows[key]["pairwise_orders"] == "" and rows[key]["ls_order"] == "nan"
+    line = rows[("roundoff", "L1_theta0")]
+    relative = [float(v) for v in line["relative_error"].split(";")]
+    floor = [float(v) for v in line["roundoff_floor"].split(";")]
+    assert relative == pytest.approx([4e-13 / 0.573977410425004, 1e-13 / 0.573977410425004,
+                                      2.5e-14 / 0.573977410425004], rel=1e-9)
+    assert floor == pytest.approx([356 * 2.220446049250313e-16 * np.pi / 0.573977410425004] * 3, rel=1e-9)
+    for key in (("small", "particle_L2"), ("small", "error_axial_stress")):
+        assert rows[key]["classification"] == "asymptotic" and float(rows[key]["ls_order"]) == pytest.approx(2.0)
+    markdown = written["markdown"].read_text()
+    assert ("| roundoff | method=cpdi | L1_theta0 [rad] | 1 | 32, 64, 128 | 2.5e-14 | - | - | round-off at "
+            "cells=64,128 (up to 1.7e-13 of the exact signal; round-off floor 4.3e-13) |") in markdown
+    [roundoff_curve] = drawn["roundoff: L1_theta0 at t = 1 s"]
+    assert roundoff_curve.label == "method=cpdi: round-off, no order" and roundoff_curve.fit is None
+    [small_curve] = drawn["small: particle_L2 at t = 1 s"]
+    assert small_curve.label == "method=cpdi" and small_curve.fit.order == pytest.approx(2.0)
+    assert "No order, errors at round-off: method=cpdi at cells=64,128" in markdown
+
+
+def test_grid_convergence_of_changes_at_round_off_has_no_order(tmp_path):
+    """Requirement: Roache's study of a point value whose changes between levels are
+    within the round-off floor ((256 + steps) ulps of the point's |X|) is classed
+    "round-off" and has no order; changes above it are studied as before."""
+    directory = write_suite_directory(tmp_path / "suite", ROUNDOFF_SUITE, roundoff_cases())
+    cases = read_suite(directory).cases_of("roundoff")         # 100 steps each
+    point = PointHistory("p", "displacement_x", np.array([0.6, 0.8]), np.zeros(1), np.zeros(1), np.zeros(1))
+    floor = 356 * 2.220446049250313e-16 * 1.0
+    assert report.point_changes_at_roundoff(cases, point, (1e-6, 1e-6 + 0.5 * floor, 1e-6 + 0.75 * floor))
+    assert not report.point_changes_at_roundoff(cases, point, (1e-6, 1e-6 + 4 * floor, 1e-6 + 6 * floor))
+

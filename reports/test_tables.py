@@ -1,11 +1,12 @@
 """Requirements of the convergence tables: an error that is exactly C h^2
-gives observed order 2 between every pair of meshes, and a stopped run is
-reported with its reason and time instead of numbers."""
+gives observed order 2 between every pair of meshes, an error at round-off
+gives none, and a stopped run is reported with its reason and time instead of
+numbers."""
 import math
 
 import convergence_table
 import study_table
-from conftest import write_ring_results
+from conftest import ROUNDOFF_SUITE, roundoff_cases, write_ring_results, write_suite_directory
 
 
 def test_observed_order_of_c_h_squared_is_two():
@@ -31,3 +32,22 @@ def test_study_table_orders_and_failures(second_order_series, tmp_path, capsys):
     assert len(rows) == 2
     for row in rows:
         assert row.split()[-1] == "2.00" and row.split()[-3] == "2.00"
+
+
+def test_study_table_prints_round_off_instead_of_an_order(tmp_path, capsys):
+    """Requirement: between two meshes where either error is at round-off
+    (conftest.roundoff_cases: the 64- and 128-cell L1 errors) the table prints
+    "round-off" instead of an order; small errors far above the floor keep theirs."""
+    cases = roundoff_cases()
+    for case in cases:
+        case["keys"].update(particles_per_direction=2, amplitude=0.5)   # study_table groups by them
+    directory = write_suite_directory(tmp_path / "suite", ROUNDOFF_SUITE, cases)
+    files = sorted(str(p) for p in (directory / "cases").glob("*.h5"))
+    roundoff = [f for f in files if "/roundoff-" in f]
+    small = [f for f in files if "/small-" in f]
+    assert study_table.main(["--times", "1.0", "--norms", "L1_theta0"] + roundoff) == 0
+    rows = [line.split() for line in capsys.readouterr().out.splitlines() if line.strip().startswith(("64", "128"))]
+    assert [row[-1] for row in rows] == ["round-off", "round-off"]
+    assert study_table.main(["--times", "1.0", "--norms", "error_axial_stress"] + small) == 0
+    rows = [line.split() for line in capsys.readouterr().out.splitlines() if line.strip().startswith(("64", "128"))]
+    assert [row[-1] for row in rows] == ["2.00", "2.00"]
