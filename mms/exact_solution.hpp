@@ -24,7 +24,9 @@ class ExactSolution {
   virtual Vec2 body_force(const Vec2& X, double t) const = 0;
   // b at every reference position (threads over the array).
   virtual void body_forces(double t, const std::vector<Vec2>& X, std::vector<Vec2>& b) const = 0;
-  virtual ResidualCheck check(const Vec2& X, double t) const = 0;
+  // The residual by finite differences with steps `step` times the motion's
+  // length and time scales (Manufactured::check).
+  virtual ResidualCheck check(const Vec2& X, double t, double step = kCheckStep) const = 0;
 };
 
 template <class Motion, class Material>
@@ -43,7 +45,9 @@ class ManufacturedSolution final : public ExactSolution {
 #pragma omp parallel for schedule(static)
     for (std::size_t p = 0; p < n; ++p) b[p] = m_.body_force(X[p], t);
   }
-  ResidualCheck check(const Vec2& X, double t) const override { return m_.check(X, t); }
+  ResidualCheck check(const Vec2& X, double t, double step = kCheckStep) const override {
+    return m_.check(X, t, step);
+  }
   const Manufactured<Motion, Material>& manufactured() const { return m_; }
 
  private:

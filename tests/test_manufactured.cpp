@@ -400,8 +400,8 @@ class PerturbedForce final : public ExactSolution {
   void body_forces(double t, const std::vector<Vec2>& X, std::vector<Vec2>& b) const override {
     for (std::size_t p = 0; p < X.size(); ++p) b[p] = body_force(X[p], t);
   }
-  ResidualCheck check(const Vec2& X, double t) const override {
-    ResidualCheck c = inner_->check(X, t);
+  ResidualCheck check(const Vec2& X, double t, double step = mpmvv::mms::kCheckStep) const override {
+    ResidualCheck c = inner_->check(X, t, step);
     const Vec2 slip = error_ * inner_->body_force(X, t);
     c.residual -= slip;
     c.scale += slip.norm();
@@ -505,6 +505,37 @@ TEST(ResidualCheck, CatchesMaterialMismatchInRz) {
   const double residual = largest_relative_residual(mismatch, points);
   RecordProperty("mu_1pc_off", scientific(residual));
   EXPECT_GT(residual, 1e-6);
+}
+
+// `mpmvv mms check`'s verdict (mms::judge_residuals) holds the residual to
+// 3 times the differences' own error, estimated from steps 1e-3 and 2e-3 of
+// the motion's scales, so it never fails on that error and fails on a wrong
+// force. The Mooney-Rivlin ring at A = 2 (c2 = 50 Pa), whose residual the
+// former fixed tolerance 1e-8 failed (2.24e-8, 1000 points, seed 1), passes
+// for every problem above and there; its force 1e-6 off fails (the largest
+// residual about 1e-6 against a tolerance of 3 times 2e-8).
+TEST(ResidualCheck, ToleranceFromTheDifferencesOwnError) {
+  std::vector<ProblemCase> cases(std::begin(kProblemCases), std::end(kProblemCases));
+  cases.push_back({"ring_mooney_rivlin_A2", "ring", {"material=mooney-rivlin", "c2=50", "body_force=derived", "amplitude=2"}});
+  for (const ProblemCase& c : cases) {
+    const Config config = config_for(c);
+    const ProblemSetup s = setup_for(c);
+    const std::vector<Sample> points = body_samples(s, config, 500, 1);
+    auto verdict = [&](const ExactSolution& solution) {
+      std::vector<ResidualCheck> fine, coarse;
+      for (const Sample& p : points) {
+        fine.push_back(solution.check(p.X, p.t));
+        coarse.push_back(solution.check(p.X, p.t, 2.0 * mpmvv::mms::kCheckStep));
+      }
+      return mpmvv::mms::judge_residuals(fine, coarse);
+    };
+    const mpmvv::mms::ResidualVerdict right = verdict(*s.solution);
+    const mpmvv::mms::ResidualVerdict wrong = verdict(PerturbedForce(s.solution, 1e-6));
+    RecordProperty(std::string(c.label) + "_residual", scientific(right.worst));
+    RecordProperty(std::string(c.label) + "_tolerance", scientific(right.tolerance));
+    EXPECT_TRUE(right.pass) << c.label << ": " << right.worst << " against " << right.tolerance;
+    EXPECT_FALSE(wrong.pass) << c.label << ": " << wrong.worst << " against " << wrong.tolerance;
+  }
 }
 
 // ---------------------------------------------------------------- the ring's closed form

@@ -98,7 +98,10 @@ int main(int argc, char** argv) {
                "derived force.\nExit status: 0 within tolerance, 1 above, 2 bad input.");
   check_cmd->add_option("name", check.name, "solution name (mpmvv mms list)")->required();
   check_cmd->add_option("--points", check.points, "random points")->check(CLI::Range(1, 10000000));
-  check_cmd->add_option("--tolerance", check.tolerance, "largest allowed relative residual")->check(CLI::PositiveNumber);
+  check_cmd->add_option("--tolerance", check.tolerance,
+                        "largest allowed relative residual (default: 3 times the differences' own error, estimated "
+                        "from two step sizes)")
+      ->check(CLI::PositiveNumber);
   check_cmd->add_option("--seed", check.seed, "random seed");
   check_cmd->add_option("--set", check.overrides, "override a parameter (repeatable)")
       ->allow_extra_args(false)

@@ -74,11 +74,11 @@ class LayeredSolution final : public mms::ExactSolution {
   // interface), so the check's differences (mms/manufactured.hpp: 3 steps of
   // a thousandth of the length each way for P, of F within each) stay within one layer: a point
   // closer to the interface is checked at the nearest point that is not.
-  mms::ResidualCheck check(const Vec2& X, double t) const override {
-    const double reach = 6.5e-3 * length_;
+  mms::ResidualCheck check(const Vec2& X, double t, double step = mms::kCheckStep) const override {
+    const double reach = 6.5 * step * length_;
     Vec2 at = X;
     if (std::abs(X.x() - interface_) < reach) at.x() = interface_ + (X.x() < interface_ ? -reach : reach);
-    return of(at).check(at, t);
+    return of(at).check(at, t, step);
   }
 
  private:
