@@ -57,13 +57,14 @@ template <class Shape, class Material>
 class ExplicitStepper final : public Stepper {
  public:
   ExplicitStepper(Model model, Scheme scheme, VelocityTransfer transfer, Material material,
-                  std::optional<Material> second_material, SceneStages stages, double gradient_scale,
+                  std::optional<Material> second_material, SceneStages stages, SolverFault fault,
                   Dilatation dilatation, double split_length, double open_cos, double viscosity_linear,
                   double viscosity_quadratic)
       : Stepper(std::move(model)),
         scheme_(scheme),
         apic_(transfer == VelocityTransfer::apic),
-        gradient_scale_(gradient_scale),
+        fault_(fault),
+        gradient_scale_(fault == SolverFault::cpdi_gradient ? kFaultyCpdiGradientScale : 1.0),
         dilatation_(dilatation),
         split_length_(split_length),
         open_cos_(open_cos),
@@ -89,8 +90,11 @@ class ExplicitStepper final : public Stepper {
       model_.particles.body_force.assign(model_.particles.size(), Vec2::Zero());
     }
     if (scheme_ == Scheme::musl) next_position_.resize(model_.particles.size());
-    // The affine part starts at zero: the first map is FLIP's.
-    if (apic_) model_.particles.affine_velocity.assign(model_.particles.size(), Mat2::Zero());
+    // The affine part starts at zero: the first map is FLIP's. (pic-velocity
+    // reads the grid's velocity as APIC does and never maps the affine part.)
+    if (apic_ || fault_ == SolverFault::pic_velocity)
+      model_.particles.affine_velocity.assign(model_.particles.size(), Mat2::Zero());
+    if (fault_ == SolverFault::lagged_stress) held_stress_ = model_.particles.stress;
     // The shape's form was chosen from the same angle (make_for_geometry).
     if ((open_cos_ < 1.0) != kTurnedDomains)
       throw std::logic_error("min_domain_angle and the CPDI form it needs were chosen apart");
@@ -137,7 +141,7 @@ class ExplicitStepper final : public Stepper {
       s = combined(s, scan_particles(shape, m, model_.particles, model_.grid.h, begin, end));
     });
     if (viscous()) s.max_signal_speed *= std::sqrt(1.0 + viscous_ratio_ * viscous_ratio_) + viscous_ratio_;
-    return s;
+    return frozen_if_faulty(s);
   }
 
   // USL and MUSL of one body of one material map mass, momentum and forces
@@ -153,6 +157,14 @@ class ExplicitStepper final : public Stepper {
     // An unhealthy particle was left out of the map: the run stops here.
     if (s.first_unhealthy == model_.particles.size()) mapped_at_ = t;
     if (viscous()) s.max_signal_speed *= std::sqrt(1.0 + viscous_ratio_ * viscous_ratio_) + viscous_ratio_;
+    return frozen_if_faulty(s);
+  }
+
+  // frozen-time-step: the signal speed of the first scan, kept.
+  ParticleScan frozen_if_faulty(ParticleScan s) const {
+    if (fault_ != SolverFault::frozen_time_step) return s;
+    if (!(first_signal_speed_ > 0.0)) first_signal_speed_ = s.max_signal_speed;
+    s.max_signal_speed = first_signal_speed_;
     return s;
   }
 
@@ -218,7 +230,7 @@ class ExplicitStepper final : public Stepper {
         perturbed.velocity[i] = eps * u[i];
         perturbed.acceleration[i].setZero();
       }
-      apply_walls(grid, perturbed);
+      walls(perturbed);
       for (std::size_t i = 0; i < nodes; ++i) u[i] = perturbed.velocity[i] / eps;
       moved.position = P.position;
       moved.deformation_gradient = P.deformation_gradient;
@@ -332,7 +344,7 @@ class ExplicitStepper final : public Stepper {
     for (GridFields* field : {&fields_, &fields_b_}) {
       update_grid_motion(*field, kick);
       if (damping_ > 0.0) damp_grid_motion(*field, damping_, kick);
-      apply_walls(model_.grid, *field);
+      walls(*field);
       if (!constraints_.empty()) {
         const std::vector<double> r = apply_constraints(constraints_, t, dt, kick, *field);
         for (std::size_t k = 0; k < r.size(); ++k) reactions[k] += r[k];
@@ -365,13 +377,13 @@ class ExplicitStepper final : public Stepper {
     const Shape shape = bind(P, domain_deformation);
     momentum_to_grid<kMass | kMomentum>(shape, fields_);
     grid_velocity_from_momentum(fields_);
-    apply_walls(model_.grid, fields_);
+    walls(fields_);
     if (!constraints_.empty()) apply_constraints(constraints_, t, dt, kick, fields_);
     if (rest_) rest_->apply(fields_, kick);
     remember_volumes();
     {
       const StageClock clock(stage_times_.update);
-      grid_to_particles<kDeformation, Shape>(shape, fields_, P, dt, kick);
+      deforming([&] { grid_to_particles<kDeformation, Shape>(shape, fields_, P, dt, kick); });
     }
     update_stress_of_particles(dt);
     if (body_force_) evaluate_body_force(t);
@@ -401,13 +413,13 @@ class ExplicitStepper final : public Stepper {
     move_domain_corners(dt, &next_corner_);
     momentum_to_grid<kMomentum>(shape, fields_);
     grid_velocity_from_momentum(fields_);
-    apply_walls(model_.grid, fields_);
+    walls(fields_);
     if (!constraints_.empty()) apply_constraints(constraints_, t, dt, kick, fields_);
     if (rest_) rest_->apply(fields_, kick);
     remember_volumes();
     {
       const StageClock clock(stage_times_.update);
-      grid_to_particles<kDeformation, Shape>(shape, fields_, P, dt, kick);
+      deforming([&] { grid_to_particles<kDeformation, Shape>(shape, fields_, P, dt, kick); });
     }
     P.position.swap(next_position_);
     if constexpr (kCornerDomains) P.domain_corner.swap(next_corner_);
@@ -416,8 +428,14 @@ class ExplicitStepper final : public Stepper {
   }
 
   Shape bind(const Particles& P, const Mat2* domain_deformation = nullptr) const {
-    return Shape::bind(model_.grid, P, domain_deformation, gradient_scale_);
+    Shape shape = Shape::bind(model_.grid, P, domain_deformation, gradient_scale_);
+    if constexpr (requires { shape.weight_skew; })
+      if (fault_ == SolverFault::cpdi_weight) shape.weight_skew = kFaultyCpdiWeightSkew;
+    return shape;
   }
+
+  // The walls (stages.hpp), or under swapped-walls the tangential component held.
+  void walls(GridFields& g) const { apply_walls(model_.grid, g, fault_ == SolverFault::swapped_walls); }
 
   // The first stage of USL and MUSL: mass, momentum and forces at t mapped to
   // the grid, with the scan of the state it weighs when `scan` is given
@@ -463,15 +481,45 @@ class ExplicitStepper final : public Stepper {
       particles_to_grid<Fields | kAffineMomentum>(shape, model_.particles, buffers_, g, range, &model_.grid, scan);
     else
       particles_to_grid<Fields>(shape, model_.particles, buffers_, g, range, nullptr, scan);
+    if constexpr ((Fields & kMass) != 0)
+      if (fault_ == SolverFault::consistent_mass) lump_consistent_diagonal(g, range);
+  }
+
+  // consistent-mass: m_g = sum_p m_p S_gp^2.
+  void lump_consistent_diagonal(GridFields& g, ParticleRange range) const {
+    const Particles& P = model_.particles;
+    const Shape shape = bind(P);
+    std::fill(g.mass.begin(), g.mass.end(), 0.0);
+    Stencil<Shape::stencil_size> st;
+    for (std::size_t p = range.first; p < range.end(P); ++p) {
+      shape.evaluate(p, st);
+      for (int k = 0; k < st.count; ++k) g.mass[st.node[k]] += P.mass[p] * st.weight[k] * st.weight[k];
+    }
   }
   template <unsigned Updates, class S>
   void velocities_from_grid(const S& shape, const GridFields& g, double dt, double kick,
                             Vec2* position_out = nullptr, ParticleRange range = {}) {
     const StageClock clock(stage_times_.update);
-    if (apic_)
-      grid_to_particles<Updates | kAffine, S>(shape, g, model_.particles, dt, kick, position_out, range);
-    else
-      grid_to_particles<Updates, S>(shape, g, model_.particles, dt, kick, position_out, range);
+    deforming<(Updates & kDeformation) != 0>([&] {
+      if (apic_ || fault_ == SolverFault::pic_velocity)
+        grid_to_particles<Updates | kAffine, S>(shape, g, model_.particles, dt, kick, position_out, range);
+      else
+        grid_to_particles<Updates, S>(shape, g, model_.particles, dt, kick, position_out, range);
+    });
+  }
+
+  // A transfer that updates F and V (kDeformation), with the faults of those
+  // updates applied after it: deformation-transpose, frozen-volume.
+  template <bool Deforms = true, class Update>
+  void deforming(Update&& update) {
+    Particles& P = model_.particles;
+    if constexpr (Deforms)
+      if (fault_ == SolverFault::deformation_transpose) held_deformation_ = P.deformation_gradient;
+    update();
+    if constexpr (Deforms) {
+      if (fault_ == SolverFault::deformation_transpose) transpose_deformation_increments(P, held_deformation_);
+      if (fault_ == SolverFault::frozen_volume) P.volume = P.reference_volume;
+    }
   }
 
   // The constitutive update, after the locking remedy when the run has it,
@@ -485,6 +533,8 @@ class ExplicitStepper final : public Stepper {
     for_each_material([&](const Material& m, std::size_t begin, std::size_t end) {
       update_stress<Shape::geometry>(m, P, begin, end);
     });
+    if (fault_ == SolverFault::kirchhoff_stress) stress_times_dilatation(P);
+    if (fault_ == SolverFault::no_hoop_stress) std::fill(P.hoop_stress.begin(), P.hoop_stress.end(), 0.0);
     if (viscous()) {
       viscous_ratio_ = 0.0;
       for_each_material([&](const Material& m, std::size_t begin, std::size_t end) {
@@ -494,6 +544,9 @@ class ExplicitStepper final : public Stepper {
         viscous_ratio_ = std::max(viscous_ratio_, v.max_ratio);
       });
     }
+    // lagged-stress: the stress just updated is held back for one step, and
+    // the forces of the next step weigh the one before it.
+    if (fault_ == SolverFault::lagged_stress) P.stress.swap(held_stress_);
   }
 
   // Calls f(material, begin, end) for each material and the particles it
@@ -522,7 +575,7 @@ class ExplicitStepper final : public Stepper {
     const StageClock clock(stage_times_.grid);
     update_grid_motion(fields_, kick);
     if (damping_ > 0.0) damp_grid_motion(fields_, damping_, kick);
-    apply_walls(model_.grid, fields_);
+    walls(fields_);
     if (!constraints_.empty()) {
       reactions_ = apply_constraints(constraints_, t, dt, kick, fields_);
       book_constraint_work(t, dt);
@@ -559,7 +612,19 @@ class ExplicitStepper final : public Stepper {
 
   void evaluate_body_force(double t) {
     const auto start = std::chrono::steady_clock::now();
-    body_force_->evaluate(t, model_.particles, model_.particles.body_force);
+    Particles& P = model_.particles;
+    if (fault_ == SolverFault::lagged_force_time) {
+      const double now = t;
+      t = std::min(t, force_time_);
+      force_time_ = now;
+    }
+    if (fault_ == SolverFault::force_at_current_position) {
+      // The force's points placed at x_p for this evaluation (and back).
+      P.reference_position.swap(P.position);
+      body_force_->prepare(P);
+      P.reference_position.swap(P.position);
+    }
+    body_force_->evaluate(t, P, P.body_force);
     forcing_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
 
@@ -574,7 +639,8 @@ class ExplicitStepper final : public Stepper {
 
   Scheme scheme_;
   bool apic_;  // velocity_transfer = apic
-  double gradient_scale_;
+  SolverFault fault_;  // none, but in a fault-injection test (faults.hpp)
+  double gradient_scale_;  // 1, but under cpdi-gradient
   Dilatation dilatation_;
   double split_length_;  // CPDI domains longer than this are split in two (split.hpp); 0: never
   double open_cos_;  // CPDI domains whose sides meet at |cos| above this are turned (domain_angle.hpp); 1: never
@@ -615,6 +681,14 @@ class ExplicitStepper final : public Stepper {
   std::vector<Vec2> next_corner_;    // MUSL with corner domains: the corners at t_{n+1}, likewise
   std::vector<Mat2> step_start_deformation_;  // USF with CPDI only: F_n, which sets the domains
   std::vector<Vec2> tracer_reference_;         // total Lagrangian: where each tracer reads the grid
+  // Held for the faults only (faults.hpp): F before an update
+  // (deformation-transpose), the stress one update behind (lagged-stress), the
+  // time of the last force evaluation (lagged-force-time) and the first
+  // scan's signal speed (frozen-time-step).
+  std::vector<Mat2> held_deformation_;
+  std::vector<Mat2> held_stress_;
+  double force_time_ = std::numeric_limits<double>::infinity();
+  mutable double first_signal_speed_ = 0.0;
 };
 
 // The cosine above which open_sheared_domains acts, from the angle in degrees below
@@ -638,7 +712,7 @@ std::unique_ptr<Stepper> make_for_shape(Model model, const SolverOptions& o, con
         return std::make_unique<ExplicitStepper<Shape, Material>>(std::move(model), o.scheme, o.velocity_transfer, m,
                                                                  std::move(second),
                                                                  std::move(stages),
-                                                                 o.cpdi_gradient_scale, o.dilatation,
+                                                                 o.fault, o.dilatation,
                                                                  o.split_domains_beyond * model.grid.h,
                                                                  min_domain_angle_cosine(o.min_domain_angle),
                                                                  o.bulk_viscosity_linear, o.bulk_viscosity_quadratic);

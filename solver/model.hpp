@@ -7,6 +7,7 @@
 #include <variant>
 #include <vector>
 
+#include "faults.hpp"
 #include "geometry.hpp"
 #include "grid.hpp"
 #include "material/mooney_rivlin.hpp"
@@ -51,9 +52,8 @@ struct SolverOptions {
   Scheme scheme = Scheme::usl;
   Geometry geometry = Geometry::plane_strain;
   // A deliberate fault, for showing that a verification gate catches one
-  // (MPMVV_FAULT=cpdi-gradient): the CPDI gradients are scaled by this factor.
-  // 1 in every real run.
-  double cpdi_gradient_scale = 1.0;
+  // (faults.hpp; MPMVV_FAULT). None in every real run.
+  SolverFault fault = SolverFault::none;
   Dilatation dilatation = Dilatation::particle;
   Formulation formulation = Formulation::updated;
   VelocityTransfer velocity_transfer = VelocityTransfer::flip;

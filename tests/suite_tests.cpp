@@ -20,45 +20,14 @@
 #include <thread>
 
 #include "solver/io/hdf5.hpp"
+#include "suite_support.hpp"
 #include "tools/app/config.hpp"
 #include "tools/app/suite.hpp"
 
 namespace {
 
-namespace fs = std::filesystem;
+using namespace mpmvv::suite_testing;
 using mpmvv::app::ConfigError;
-
-const std::string kScenes = std::string(MPMVV_SOURCE_DIR) + "/suites/scenes";
-
-fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("mpmvv-suite-tests-" + std::to_string(::getpid())) / name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-fs::path write(const fs::path& path, const std::string& text) {
-  std::ofstream(path) << text;
-  return path;
-}
-
-std::string read(const fs::path& path) {
-  std::ifstream in(path);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-int shell(const std::string& command) {
-  const int status = std::system((command + " > /dev/null 2>&1").c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-int count(const std::string& text, const std::string& what) {
-  int n = 0;
-  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
-  return n;
-}
 
 std::string config_error(const fs::path& suite) {
   try {
@@ -282,6 +251,84 @@ TEST(SuiteRunner, ResumeRunsFaultedAndDamagedResultsAgain) {
   manifest = read(dir / "out" / "manifest.json");
   EXPECT_EQ(count(manifest, "kept from an earlier run"), 2) << manifest;
   EXPECT_TRUE(mpmvv::h5::File::open_read(damaged.string()).root().has("errors"));
+  // A results file written before the health verdict (no attribute health):
+  // it could read "completed" with its solution lost, so it runs again.
+  const fs::path old = dir / "out/cases/square-cells=16.h5";
+  {
+    const hid_t file = H5Fopen(old.string().c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    ASSERT_GE(file, 0);
+    EXPECT_GE(H5Adelete(file, "health"), 0);
+    H5Fclose(file);
+  }
+  ASSERT_EQ(shell(run), 0);
+  manifest = read(dir / "out" / "manifest.json");
+  EXPECT_EQ(count(manifest, "kept from an earlier run"), 2) << manifest;
+  EXPECT_TRUE(mpmvv::h5::File::open_read(old.string()).root().has_attribute("health"));
+}
+
+// A full disk, made here by a partial file that is a link to /dev/full
+// (every write to it fails with ENOSPC). A run whose results cannot be
+// written ends with one line and exit 2, not a crash, and leaves no file; a
+// suite whose manifest cannot be written stops with one line and exit 1,
+// keeps the results it finished and the last manifest it wrote (valid JSON),
+// and a rerun once there is room resumes.
+TEST(SuiteRunner, AFullDiskEndsACaseOrTheSuiteWithOneLine) {
+  const fs::path dir = scratch("full-disk");
+  const fs::path out = dir / "out";
+  fs::create_directories(out);
+  const fs::path message = dir / "message.txt";
+  fs::create_symlink("/dev/full", out / "r.h5.partial");
+  const std::string run_one = std::string(MPMVV_BINARY) + " run " + kScenes +
+                              "/axis-aligned.toml --set cells=8 --set end_time=0.005 --set output_times=[0.005] -q -o " +
+                              (out / "r.h5").string();
+  int status = std::system((run_one + " > /dev/null 2> " + message.string()).c_str());
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 2) << read(message);
+  EXPECT_EQ(count(read(message), "\n"), 1) << read(message);
+  EXPECT_NE(read(message).find("No space left on device"), std::string::npos) << read(message);
+  EXPECT_FALSE(fs::exists(out / "r.h5"));
+  EXPECT_FALSE(fs::is_symlink(out / "r.h5.partial"));
+
+  const fs::path suite = write(dir / "s.toml", small_suite());
+  const std::string run = std::string(MPMVV_BINARY) + " suite " + suite.string() + " -j 1 -q -o " + out.string();
+  ASSERT_EQ(shell(run + " --only 'cells=8$'"), 0);
+  fs::create_symlink("/dev/full", out / "manifest.json.partial");
+  status = std::system((run + " > /dev/null 2> " + message.string()).c_str());
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 1) << read(message);
+  EXPECT_NE(read(message).find("manifest.json.partial (write): No space left on device; the suite stopped"),
+            std::string::npos)
+      << read(message);
+  // The manifest the first run wrote, whole: case 8 completed, the others pending.
+  const std::string manifest = read(out / "manifest.json");
+  ASSERT_GE(manifest.size(), 4u);
+  EXPECT_EQ(manifest.substr(manifest.size() - 4), "\n]}\n") << manifest;
+  EXPECT_EQ(count(manifest, "\"status\": \"completed\""), 1) << manifest;
+  EXPECT_EQ(count(manifest, "\"status\": \"pending\""), 2) << manifest;
+  // The case that finished before the manifest failed (-j 1: the first) is kept.
+  EXPECT_TRUE(fs::exists(out / "cases/square-cells=12.h5"));
+  fs::remove(out / "manifest.json.partial");
+  ASSERT_EQ(shell(run), 0);
+  const std::string resumed = read(out / "manifest.json");
+  EXPECT_EQ(count(resumed, "\"status\": \"completed\""), 3) << resumed;
+  EXPECT_EQ(count(resumed, "kept from an earlier run"), 2) << resumed;
+}
+
+// An expectation read where the exact signal is trivial (the r-z cylinder at
+// t = 1 s, where its exact displacement is zero) is warned about when the
+// suite is loaded, before anything runs, naming the file and line; one read
+// where the motion is large is not.
+TEST(SuiteFile, WarnsOfAReadWhereTheExactSignalIsTrivial) {
+  const fs::path dir = scratch("trivial-read");
+  const fs::path suite = write(dir / "s.toml", "[[study]]\nname = \"rz\"\nscene = \"" + kScenes +
+                                                   "/rz-cylinder.toml\"\nsweep = { cells = [8, 16] }\n"
+                                                   "[[expect]]\nstudy = \"rz\"\nnorm = \"particle_L2\"\n"
+                                                   "time = 1.0\norder = 2.0\ntolerance = 0.3\n"
+                                                   "[[expect]]\nstudy = \"rz\"\nnorm = \"L1_line_z_quarter\"\n"
+                                                   "time = 0.25\norder = 2.0\ntolerance = 0.3\n");
+  const mpmvv::app::Suite loaded = mpmvv::app::load_suite(suite.string());
+  ASSERT_EQ(loaded.warnings.size(), 1u);
+  EXPECT_NE(loaded.warnings[0].find("s.toml:5"), std::string::npos) << loaded.warnings[0];
+  EXPECT_NE(loaded.warnings[0].find("particle_L2 at t = 1 where the exact signal is 0 %"), std::string::npos)
+      << loaded.warnings[0];
 }
 
 // --only runs the cases whose id the regular expression finds and leaves the

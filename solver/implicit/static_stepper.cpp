@@ -500,6 +500,9 @@ std::unique_ptr<Stepper> make_static_stepper(Model model, const SolverOptions& o
                                              SceneStages stages, const StaticOptions& o) {
   if (options.geometry != Geometry::plane_strain)
     throw std::invalid_argument("the implicit static step is plane strain only");
+  if (options.fault != SolverFault::none)
+    throw std::invalid_argument(fmt::format("the deliberate fault {} is injected into the explicit step only",
+                                            to_string(options.fault)));
   if (model.particles.size() == 0) throw std::invalid_argument("the scene seeded no particles");
   if (options.method == Method::bspline || options.method == Method::bspline_cubic)
     throw std::invalid_argument(fmt::format("method {} serves the explicit step only", to_string(options.method)));

@@ -1,6 +1,9 @@
 #include "hdf5.hpp"
 
 #include <stdexcept>
+#include <vector>
+
+#include "write_file.hpp"
 
 namespace mpmvv::h5 {
 
@@ -227,9 +230,12 @@ File File::create(const std::string& path) {
   Handle fcpl(check(H5Pcreate(H5P_FILE_CREATE), "H5Pcreate", path), H5Pclose);
   check_status(H5Pset_link_creation_order(fcpl.get(), H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED),
                "H5Pset_link_creation_order", path);
-  return File(Handle(check(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, fcpl.get(), H5P_DEFAULT), "H5Fcreate", path),
+  Handle fapl(check(H5Pcreate(H5P_FILE_ACCESS), "H5Pcreate", path), H5Pclose);
+  // In memory, grown a MiB at a time, with no backing store: save() writes it.
+  check_status(H5Pset_fapl_core(fapl.get(), std::size_t(1) << 20, 0), "H5Pset_fapl_core", path);
+  return File(Handle(check(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, fcpl.get(), fapl.get()), "H5Fcreate", path),
                      H5Fclose),
-              path);
+              path, true);
 }
 
 File File::open_read(const std::string& path) {
@@ -240,8 +246,15 @@ Group File::root() const {
   return Group(Handle(check(H5Gopen2(handle_.get(), "/", H5P_DEFAULT), "H5Gopen2", path_ + ":/"), H5Gclose), "/");
 }
 
-void File::flush() const {
+void File::save() const {
   check_status(H5Fflush(handle_.get(), H5F_SCOPE_GLOBAL), "H5Fflush", path_);
+  if (!in_memory_) return;
+  const ssize_t size = H5Fget_file_image(handle_.get(), nullptr, 0);
+  if (size < 0) throw std::runtime_error("HDF5 H5Fget_file_image failed on " + path_);
+  std::vector<char> image(static_cast<std::size_t>(size));
+  if (H5Fget_file_image(handle_.get(), image.data(), image.size()) != size)
+    throw std::runtime_error("HDF5 H5Fget_file_image failed on " + path_);
+  io::write_file(path_, image.data(), image.size());
 }
 
 }  // namespace mpmvv::h5

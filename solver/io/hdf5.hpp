@@ -64,16 +64,23 @@ class Group {
 
 class File {
  public:
-  static File create(const std::string& path);     // truncates
+  // A new file, built in memory (HDF5's core driver) and written to `path`
+  // by save(): HDF5 itself never writes to the disk, so a full disk is one
+  // checked write (io/write_file.hpp), not a failed flush that HDF5 retries,
+  // and crashes on, when the library shuts down.
+  static File create(const std::string& path);
   static File open_read(const std::string& path);
   Group root() const;
   const std::string& path() const { return path_; }
-  void flush() const;
+  // Writes the file's image to its path (create) or flushes it (open_read).
+  void save() const;
 
  private:
-  File(Handle handle, std::string path) : handle_(std::move(handle)), path_(std::move(path)) {}
+  File(Handle handle, std::string path, bool in_memory = false)
+      : handle_(std::move(handle)), path_(std::move(path)), in_memory_(in_memory) {}
   Handle handle_;
   std::string path_;
+  bool in_memory_;
 };
 
 }  // namespace mpmvv::h5

@@ -68,8 +68,11 @@ struct CpdiShapeT {
   const Mat2* deformation_gradient;
   const Vec2* half_size;
   const Mat2* domain_axes;  // Turned: A_p; else null, and the domains span diag(half_size)
-  double gradient_scale;  // 1, but for a deliberate fault (SolverOptions::cpdi_gradient_scale)
+  double gradient_scale;  // 1, but for a deliberate fault (faults.hpp: cpdi-gradient)
   const Vec2* corners;    // Corners: x_pc, four per particle (Particles::domain_corner); else null
+  // 0, but for a deliberate fault (faults.hpp: cpdi-weight): the corner
+  // shares of S_gp are (1/4)(1 + weight_skew xi_c). Parallelogram domains only.
+  double weight_skew = 0.0;
 
   // The domains span F_p diag(l_p); `deformation_gradient` may point to a copy
   // of F taken at the start of a step, so that every transfer of the step uses
@@ -192,7 +195,7 @@ struct CpdiShapeT {
     else corner_gradients(p, s, corner_gradient);
     for (int c = 0; c < 4; ++c) {
       if constexpr (!Corners) {
-        double cw = 0.25;
+        double cw = 0.25 * (1.0 + weight_skew * corner_xi[c]);
         if constexpr (G == Geometry::axisymmetric) cw *= 1.0 + weight_a * corner_xi[c] + weight_b * corner_eta[c];
         corner_weight[c] = cw;
       }

@@ -130,7 +130,7 @@ struct CpdiExactShapeT {
   const Vec2* half_size;
   const std::uint32_t* domain_first;  // null when no particle has an outline of its own
   const Vec2* domain_vertex;
-  double gradient_scale;  // 1, but for a deliberate fault (SolverOptions::cpdi_gradient_scale)
+  double gradient_scale;  // 1, but for a deliberate fault (faults.hpp: cpdi-gradient)
   const Vec2* corners;    // Corners: x_pc, four per particle (Particles::domain_corner); else null
 
   static CpdiExactShapeT bind(const GridGeometry& grid, const Particles& particles,

@@ -8,25 +8,43 @@
 
 namespace mpmvv::app {
 
-const char* to_string(Fault f) {
-  switch (f) {
+namespace {
+
+const char* kind_name(Fault::Kind k) {
+  switch (k) {
     case Fault::none: return "";
     case Fault::no_body_force: return "no-body-force";
-    case Fault::cpdi_gradient: return "cpdi-gradient";
     case Fault::crash: return "crash";
     case Fault::hang: return "hang";
+    case Fault::solver: return "solver";
   }
   return "?";
 }
 
+}  // namespace
+
+std::string to_string(const Fault& f) {
+  return f.kind == Fault::solver ? mpmvv::to_string(f.in_solver) : kind_name(f.kind);
+}
+
 Fault injected_fault(const std::string& results_path) {
   const char* value = std::getenv("MPMVV_FAULT");
-  if (!value || !*value) return Fault::none;
+  if (!value || !*value) return {};
+  Fault f;
+  for (Fault::Kind k : {Fault::no_body_force, Fault::crash, Fault::hang})
+    if (std::string(value) == kind_name(k)) f.kind = k;
+  if (f.kind == Fault::none) {
+    f.in_solver = solver_fault_named(value);
+    if (f.in_solver == SolverFault::none) {
+      std::string names = "no-body-force, crash, hang";
+      for (SolverFault s : kSolverFaults) names += fmt::format(", {}", mpmvv::to_string(s));
+      throw ConfigError(fmt::format("MPMVV_FAULT={}: unknown fault ({})", value, names));
+    }
+    f.kind = Fault::solver;
+  }
   const char* only = std::getenv("MPMVV_FAULT_ONLY");
-  for (Fault f : {Fault::no_body_force, Fault::cpdi_gradient, Fault::crash, Fault::hang})
-    if (std::string(value) == to_string(f))
-      return only && *only && results_path.find(only) == std::string::npos ? Fault::none : f;
-  throw ConfigError(fmt::format("MPMVV_FAULT={}: unknown fault (no-body-force, cpdi-gradient, crash, hang)", value));
+  if (only && *only && results_path.find(only) == std::string::npos) return {};
+  return f;
 }
 
 }  // namespace mpmvv::app

@@ -1,27 +1,36 @@
 // Deliberate faults, for showing that the gate catches real defects and that a
 // suite survives a broken case. Set MPMVV_FAULT for `mpmvv run` (a suite passes
-// its environment to every case):
+// its environment to every case) to one of
 //   no-body-force   the scene's body force stage is left out
-//   cpdi-gradient   CPDI corner gradients carry 1/4 * 1.04 instead of 1/4 (eq. 1.100)
 //   crash           the run aborts after reading its configuration
 //   hang            the run never ends
-// With MPMVV_FAULT_ONLY=TEXT the fault applies only to runs whose results file
-// path contains TEXT (one case of a suite). A results file records the fault it
-// ran with (attribute fault_injected).
+// or to a mistake in the explicit step, solver/faults.hpp (cpdi-weight,
+// cpdi-gradient, deformation-transpose, frozen-volume, lagged-stress,
+// no-hoop-stress, force-at-current-position, lagged-force-time,
+// frozen-time-step, consistent-mass, pic-velocity, kirchhoff-stress,
+// swapped-walls). With MPMVV_FAULT_ONLY=TEXT the fault applies only to runs
+// whose results file path contains TEXT (one case of a suite). A results file
+// records the fault it ran with (attribute fault_injected).
 #pragma once
 
 #include <string>
 
+#include "solver/faults.hpp"
+
 namespace mpmvv::app {
 
-enum class Fault { none, no_body_force, cpdi_gradient, crash, hang };
+struct Fault {
+  enum Kind { none, no_body_force, crash, hang, solver };
+  Kind kind = none;
+  SolverFault in_solver = SolverFault::none;  // kind == solver: which
+
+  bool operator==(Kind k) const { return kind == k; }
+};
 
 // From MPMVV_FAULT (and MPMVV_FAULT_ONLY) for a run writing `results_path`;
 // throws ConfigError for a value not listed above.
 Fault injected_fault(const std::string& results_path);
-const char* to_string(Fault f);
-
-// The factor a cpdi-gradient fault puts on CPDI gradients.
-inline constexpr double kFaultyCpdiGradientScale = 1.04;
+// Its name as MPMVV_FAULT spells it; empty for none.
+std::string to_string(const Fault& f);
 
 }  // namespace mpmvv::app

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <numbers>
 #include <stdexcept>
@@ -172,7 +173,7 @@ class MmsCase final : public SceneCase, private RunObserver {
 
   void inject(Fault fault) override {
     fault_ = fault;
-    options_.cpdi_gradient_scale = fault == Fault::cpdi_gradient ? kFaultyCpdiGradientScale : 1.0;
+    options_.fault = fault.in_solver;
   }
 
   // The memory the case will hold, estimated before anything is allocated:
@@ -604,6 +605,49 @@ class MmsCase final : public SceneCase, private RunObserver {
     history_values_.assign(setup_.history_names.size(), {});
   }
 
+  std::optional<double> exact_signal_fraction(const std::string& norm, double time) const override {
+    if (!setup_.solution) return std::nullopt;
+    if (std::isnan(time)) time = loop_.end_time;
+    std::function<double(double)> signal;
+    if (norm.starts_with("L1_")) {
+      const auto line = std::find_if(setup_.lines.begin(), setup_.lines.end(),
+                                     [&](const ProbeLine& l) { return "L1_" + l.name == norm; });
+      if (line == setup_.lines.end() || line->reference.empty()) return std::nullopt;
+      signal = [this, &line = *line](double t) {
+        double sum = 0.0;
+        for (const Vec2& X : line.reference) sum += std::abs(exact_at(line.quantity, X, t));
+        return sum / double(line.reference.size());
+      };
+    } else if (norm == "particle_L1" || norm == "particle_L2" || norm == "particle_Linf") {
+      // The body sampled on a 48 x 48 lattice over the walls' box.
+      std::vector<Vec2> body;
+      const Vec2 lo = setup_.grid.wall_lower(), hi = setup_.grid.wall_upper();
+      for (int j = 0; j < 48; ++j)
+        for (int i = 0; i < 48; ++i) {
+          const Vec2 X = lo + (hi - lo).cwiseProduct(Vec2((i + 0.5) / 48.0, (j + 0.5) / 48.0));
+          if (setup_.contains(X)) body.push_back(X);
+        }
+      if (body.empty()) return std::nullopt;
+      signal = [this, body = std::move(body)](double t) {
+        double sum = 0.0;
+        for (const Vec2& X : body) sum += (setup_.solution->position(X, t) - X).squaredNorm();
+        return std::sqrt(sum / double(body.size()));
+      };
+    } else {
+      return std::nullopt;
+    }
+    std::vector<double> times = loop_.output_times;
+    if (times.empty() || times.back() < loop_.end_time) times.push_back(loop_.end_time);
+    double largest = 0.0, at = std::numeric_limits<double>::quiet_NaN();
+    for (double t : times) {
+      const double s = signal(t);
+      largest = std::max(largest, s);
+      if (std::abs(t - time) <= 1e-9 * std::max(1.0, std::abs(time))) at = s;
+    }
+    if (!std::isfinite(at) || !(largest > 0.0)) return std::nullopt;
+    return at / largest;
+  }
+
   double value_at(ProbeQuantity q, const Vec2& x, const Vec2& X, double t) const {
     return probe_value(q, setup_.geometry, x, X, setup_.solution->position(X, t));
   }
@@ -830,7 +874,7 @@ class MmsCase final : public SceneCase, private RunObserver {
   }
 
   Config config_;
-  Fault fault_ = Fault::none;
+  Fault fault_;
   bool exact_seeding_ = false;
   double particle_volume_ = 0.0;
   std::size_t first_material_count_ = 0;  // with a second material: the particles of the first

@@ -156,7 +156,7 @@ void write_results_file(const std::string& path, const RunRequest& request, cons
     h5::Group g = root.create_group("measurements");
     for (const auto& [name, value] : m) g.set_attribute(name, value);
   }
-  file.flush();
+  file.save();
 }
 
 // On a terminal one line rewritten every second; in a log a new line every
@@ -214,7 +214,7 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
   std::unique_ptr<SceneCase> scene;
   Config config("", {});
   std::string output = request.output;
-  Fault fault = Fault::none;
+  Fault fault;
   try {
     config = load(request.scene_file, request.overrides);
     scene = find_scene_type(config.scene())->build(config);

@@ -33,6 +33,7 @@
 
 #include "config.hpp"
 #include "fault.hpp"
+#include "solver/io/write_file.hpp"
 #include "scene.hpp"
 #include "solver/io/hdf5.hpp"
 #include "solver/time_loop.hpp"
@@ -320,6 +321,28 @@ void check_references(const toml::table& top, const std::string& path,
   }
 }
 
+// Below this fraction of its largest over the output times, the exact signal
+// an expectation reads measures little: a run without the motion would score
+// nearly the same there (reports/gate.py: TRIVIAL_SIGNAL, the same rule after
+// the run).
+constexpr double kTrivialSignal = 0.05;
+
+// A warning when expectation `e` reads its norm where the exact signal is
+// trivial, judged on the first case of its study (the levels of a study share
+// the motion).
+void warn_of_a_trivial_read(const toml::table& e, const std::string& here, const SceneCase& scene,
+                            std::vector<std::string>& warnings) {
+  const std::string norm = e.get("norm")->as_string()->get();
+  const double time = e.get("time") ? e.get("time")->value<double>().value_or(0.0) : std::numeric_limits<double>::quiet_NaN();
+  const std::optional<double> fraction = scene.exact_signal_fraction(norm, time);
+  if (fraction && *fraction < kTrivialSignal)
+    warnings.push_back(fmt::format(
+        "{}: [[expect]] reads {} {} where the exact signal is {:.3g} % of its largest over the output times: a run "
+        "without the motion would score nearly the same; read it where the motion is large",
+        here, norm, std::isnan(time) ? std::string("at the end time") : fmt::format("at t = {:g}", time),
+        100.0 * *fraction));
+}
+
 }  // namespace
 
 Suite load_suite(const std::string& path) {
@@ -354,6 +377,7 @@ Suite load_suite(const std::string& path) {
   const fs::path base = fs::path(path).parent_path();
   const std::regex name_pattern("[A-Za-z0-9_-]+");
   std::map<std::string, std::vector<KeySpec>> study_keys;
+  std::map<std::string, std::unique_ptr<SceneCase>> first_of_study;  // built, for what is known before a run
   std::map<std::string, std::vector<const SuiteCase*>> study_cases;
 
   for (const toml::node& node : *studies->as_array()) {
@@ -469,7 +493,8 @@ Suite load_suite(const std::string& path) {
             for (const Setting& s : ov.set) apply(s.key, s.value, s.origin);
         }
         // The scene's own rules between keys, before anything runs.
-        find_scene_type(config.scene())->build(config);
+        std::unique_ptr<SceneCase> built = find_scene_type(config.scene())->build(config);
+        if (!first_of_study.count(name)) first_of_study[name] = std::move(built);
         c.configuration = config.to_toml();
         c.defaults = Config(config.scene(), specs).to_toml();
         for (const KeySpec& k : specs) c.keys[k.name] = json_value(config.value(k.name));
@@ -548,6 +573,7 @@ Suite load_suite(const std::string& path) {
           throw ConfigError(fmt::format("{}: [[expect]]: 'refine' must name a key of study '{}'", where_in(path, *r), name));
         refine = r->as_string()->get();
       }
+      warn_of_a_trivial_read(e, here, *first_of_study.at(name), suite.warnings);
       if (const toml::node* l = e.get("levels")) {
         const std::optional<Value> v = to_value(*l);
         if (!v || !std::holds_alternative<std::vector<double>>(*v) || std::get<std::vector<double>>(*v).size() < 2)
@@ -592,14 +618,14 @@ std::string case_json(const SuiteCase& c, const CaseState& s, const std::string&
       json_string(s.status), s.exit_code, fmt::format("{:.6g}", s.wall), json_string(s.detail));
 }
 
+// Written whole under a partial name, then renamed over `path`: a full disk
+// leaves the file as it was (io::write_file throws, naming the reason).
 void write_atomically(const fs::path& path, const std::string& text) {
   const fs::path partial = path.string() + ".partial";
-  {
-    std::ofstream out(partial);
-    out << text;
-    if (!out) throw std::runtime_error("cannot write " + partial.string());
-  }
-  fs::rename(partial, path);
+  io::write_file(partial.string(), text);
+  std::error_code ec;
+  fs::rename(partial, path, ec);
+  if (ec) throw std::runtime_error("cannot rename " + partial.string() + " to " + path.filename().string() + ": " + ec.message());
 }
 
 std::string read_text(const fs::path& path) {
@@ -669,7 +695,7 @@ std::optional<CaseState> finished_state(const fs::path& results, const SuiteCase
     // case's result, and a file without its error table is damaged: both run
     // again.
     const std::string fault = root.has_attribute("fault_injected") ? root.attribute_string("fault_injected") : "";
-    Fault now = Fault::none;
+    Fault now;
     try {
       now = injected_fault(results.string());
     } catch (const ConfigError&) {
@@ -679,6 +705,9 @@ std::optional<CaseState> finished_state(const fs::path& results, const SuiteCase
     CaseState s;
     s.status = root.attribute_string("status");
     if (s.status == kInterrupted) return std::nullopt;  // stopped by a signal before its end: run it again
+    // A run written before the health verdict (tools/app/health.hpp) could
+    // read "completed" with its solution lost: it runs again to be judged.
+    if (!root.has_attribute("health")) return std::nullopt;
     s.exit_code = s.status == "completed" ? 0 : 1;
     s.wall = root.attribute_double("wall_time_s");
     if (s.status != "completed")
@@ -806,6 +835,8 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
     if (rank == 0) fmt::print(err, "mpmvv suite: {}\n", e.what());
     return finish_mpi(2);
   }
+  if (rank == 0)
+    for (const std::string& w : suite.warnings) fmt::print(err, "mpmvv suite: warning: {}\n", w);
   std::regex only;
   try {
     only = std::regex(request.only.empty() ? std::string(".") : request.only);
@@ -913,6 +944,20 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
                                  json_string(stamp), cases));
   };
 
+  // A write of the suite's own files that fails (a full disk) stops the
+  // suite as an interrupt does: what is finished stays, and the last
+  // manifest written stays whole.
+  std::string write_failure;
+  auto guarded = [&](auto&& write) {
+    if (!write_failure.empty()) return;
+    try {
+      write();
+    } catch (const std::exception& e) {
+      write_failure = e.what();
+    }
+  };
+  auto stopping = [&] { return interrupted || !write_failure.empty(); };
+
   // This rank's share, and what an earlier run already finished.
   std::vector<std::size_t> queue;
   std::size_t resumed = 0, unselected = 0;
@@ -921,7 +966,7 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
     if (const auto done = finished_state(results_of(i), suite.cases[i])) {
       state[i] = *done;
       state[i].detail = (state[i].detail.empty() ? "" : state[i].detail + "; ") + "kept from an earlier run";
-      record(i);
+      guarded([&] { record(i); });
       ++resumed;
     } else if (selected(suite.cases[i])) {
       queue.push_back(i);
@@ -983,8 +1028,8 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
     err.flush();
   };
 
-  while ((next < queue.size() || !running.empty()) && !interrupted) {
-    while (next < queue.size() && int(running.size()) < jobs && !interrupted) {
+  while ((next < queue.size() || !running.empty()) && !stopping()) {
+    while (next < queue.size() && int(running.size()) < jobs && !stopping()) {
       const std::size_t i = queue[next++];
       fs::remove(results_of(i), ec);
       try {
@@ -994,7 +1039,7 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
         state[i].status = "running";
       } catch (const std::exception& e) {
         state[i] = {"error", -1, 0.0, e.what()};
-        record(i);
+        guarded([&] { record(i); });
         ++finished;
       }
     }
@@ -1037,25 +1082,31 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
         }
       }
       fs::remove(results_of(i).string() + ".partial", ec);
-      record(i);
+      guarded([&] { record(i); });
       ++finished;
       finished_wall += wall;
       if (!tty && !request.quiet)
         fmt::print(err, "{}case {}: {} ({:.3g} s){}\n", prefix, suite.cases[i].id, s.status, wall,
                    s.detail.empty() ? "" : ", " + s.detail);
-      if (ranks == 1) write_manifest();
+      if (ranks == 1) guarded(write_manifest);
       it = running.erase(it);
     }
     progress(false);
     if (!running.empty()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
 
-  if (interrupted) {
+  if (stopping()) {
     for (const Running& r : running) kill(-r.pid, SIGTERM);
     for (const Running& r : running) waitpid(r.pid, nullptr, 0);
     for (const Running& r : running) fs::remove(results_of(r.index).string() + ".partial", ec);
-    if (ranks == 1) write_manifest();
+    if (ranks == 1) guarded(write_manifest);
     if (tty && !request.quiet) fmt::print(err, "\n");
+    if (!write_failure.empty()) {
+      fmt::print(err, "{}mpmvv suite: {}; the suite stopped: {} {} finished, their results and the last manifest "
+                 "written are kept; make room and rerun the same command to resume\n",
+                 prefix, write_failure, finished, finished == 1 ? "case" : "cases");
+      return finish_mpi(1);
+    }
     fmt::print(err, "{}mpmvv suite: interrupted; {} cases finished; rerun the same command to resume\n", prefix, finished);
     return finish_mpi(130);
   }
@@ -1067,7 +1118,7 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
 #endif
   int status = 0;
   if (rank == 0) {
-    write_manifest();
+    guarded(write_manifest);
     // Every case's state, from the status files all ranks wrote.
     std::string table = fmt::format("suite {} ({} cases) -> {}\n{:<48} {:<10} {:>9}  {}\n", suite.name, n, dir.string(),
                                     "case", "status", "wall [s]", "detail");
@@ -1094,8 +1145,13 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
     for (const auto& [k, v] : counts) totals += fmt::format("{}{} {}", totals.empty() ? "" : ", ", v, k);
     table += fmt::format("{} in {}\n", totals,
                          duration(std::chrono::duration<double>(std::chrono::steady_clock::now() - suite_start).count()));
-    write_atomically(dir / "summary.txt", table);
+    guarded([&] { write_atomically(dir / "summary.txt", table); });
     fmt::print(out, "{}", table);
+    if (!write_failure.empty()) {
+      fmt::print(err, "mpmvv suite: {}; every case finished, and the results written are kept; make room and rerun "
+                 "the same command to write the manifest and summary\n", write_failure);
+      status = 1;
+    }
   }
   return finish_mpi(status);
 }

@@ -28,6 +28,9 @@ struct Suite {
   std::string description;
   double timeout_seconds = 3600.0;
   std::vector<SuiteCase> cases;
+  // What the loader found doubtful but not wrong, each with the file and line
+  // (an expectation read where the exact signal is trivial).
+  std::vector<std::string> warnings;
 };
 
 // Reads and checks a suite file and every case it makes; throws ConfigError
