@@ -43,7 +43,8 @@ def read_case(path, times, norms):
         attrs = f.attrs
         return {
             "scene": text(attrs["scene"]) if "scene" in attrs else "ring",
-            "amplitude": float(attrs["amplitude"]) if "amplitude" in attrs else float("nan"),
+            # None, not NaN, for a scene without one: NaN would make every file a group of its own.
+            "amplitude": float(attrs["amplitude"]) if "amplitude" in attrs else None,
             "variant": text(attrs["variant"]) if "variant" in attrs else "",
             "extra": f"R_i={float(attrs['inner_radius']):g}" if text(attrs.get("scene", "")) == "rz-cylinder" else "",
             "method": text(attrs["method"]),
@@ -91,10 +92,12 @@ def main(argv):
     for path in args.files:
         c = read_case(path, times, norms)
         groups[(c["scene"], c["variant"], c["extra"], c["amplitude"], c["ppd"], c["method"])].append(c)
-    for key in sorted(groups, key=lambda k: (k[0], k[1], k[2], k[3], k[4], METHOD_ORDER.get(k[5], 9))):
+    for key in sorted(groups, key=lambda k: (k[0], k[1], k[2], k[3] is not None, k[3] or 0.0, k[4],
+                                             METHOD_ORDER.get(k[5], 9))):
         cases = sorted(groups[key], key=lambda c: c["cells"])
         scene, variant, extra, amplitude, ppd, method = key
-        label = ", ".join(x for x in (scene, variant, extra, f"A = {amplitude:g}", f"{ppd} per direction", method) if x)
+        label = ", ".join(x for x in (scene, variant, extra, "" if amplitude is None else f"A = {amplitude:g}",
+                                      f"{ppd} per direction", method) if x)
         print(f"\n{label}")
         columns = cases[0]["columns"]
         head = f"{'cells':>6} {'outcome':<34} {'wall [s]':>9} {'forcing':>8} {'steps':>6}"
