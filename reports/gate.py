@@ -185,6 +185,13 @@ def check_series(number, expect, series):
         reasons.append(f"E/h^{order:g} = {constant:.3g} > {limit:g}")
     if len(good) >= (2 if has_order else 1):
         notes = interval_notes + [f"left out {series.refine}={l.value} ({l.reason})" for l in levels if l.reason]
+        # The report's figure fits every usable level of the series: where the
+        # expectation names fewer, the two orders differ, and both say which.
+        if has_order and "levels" in expect:
+            every = usable(series_levels(series, expect["norm"], expect.get("time")))
+            if [l.value for l in every] != [l.value for l in good]:
+                notes.append(f"fitted on {series.refine}={','.join(str(l.value) for l in good)}; the report's "
+                             f"figure fits all {len(every)} usable levels")
     read_time = expect.get("time")
     fractions = [f for f in (exact_signal_fraction(l.case, expect["norm"],
                                                    l.case.end_time if read_time is None else float(read_time))

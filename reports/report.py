@@ -321,7 +321,8 @@ def error_figure(study, norm, time, rows, styles, quantities, directory):
     figures.save_png(figure, path)
     missing = [r.series.label for r in chosen if not r.levels]
     caption = (f"{study}: {norms.describe_norm(norm, quantities)} [{unit}] at {when} against {against}; "
-               f"dashed: least-squares fit; grey: slopes 1 and 2.")
+               f"dashed: least-squares fit over every usable level drawn (an expectation naming fewer levels "
+               f"fits those, as the verdict's levels column says); grey: slopes 1 and 2.")
     at_floor = [r for r in chosen if not r.has_order]
     if at_floor:
         caption += " No order, errors at round-off: " + "; ".join(

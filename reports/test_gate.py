@@ -491,3 +491,18 @@ def test_a_small_strain_is_rounded_to_ulps_of_one(tmp_path):
     # Without F in the file the ratio's own floor, 7.9e-14.
     assert error_scale(by_id["bar-cells=16"], "error_axial_strain", 1.0) == (1.0, 1.0)
 
+
+
+def test_a_fit_on_fewer_levels_than_the_figure_says_which(tmp_path, capsys):
+    """Requirement: where an expectation names fewer levels than the series has
+    usable (64, 128 of 32, 64, 128), its row says which it fitted and that the
+    report's figure fits them all; where it names them all, no such note."""
+    suite = SYNTHETIC_SUITE.replace("levels = [32, 64, 128]", "levels = [64, 128]")
+    directory = write_suite_directory(tmp_path / "suite", suite, synthetic_ring_cases())
+    status, out, _ = run_gate(directory, capsys)
+    [row] = rows_of(out)
+    assert status == 0 and "PASS" in row
+    assert "fitted on cells=64,128; the report's figure fits all 3 usable levels" in row
+    directory = write_suite_directory(tmp_path / "all", SYNTHETIC_SUITE, synthetic_ring_cases())
+    _, out, _ = run_gate(directory, capsys)
+    assert "fitted on" not in out
