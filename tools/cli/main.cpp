@@ -33,7 +33,8 @@ int main(int argc, char** argv) {
       "run", "Run one case of a scene and write its results file.\n"
              "Exit status: 0 completed, 1 the solver stopped the run (results still written with status "
              "\"failed\") or it ran to its end with its solution lost (status \"lost\": the health verdict, "
-             "keys health_J_factor and health_energy_loss_factor), 2 bad input.");
+             "keys health_J_factor and health_energy_loss_factor), 2 bad input or a results file that could not be "
+             "written (a full disk: the reason is named, no file is left).");
   run_cmd->add_option("scene", run.scene_file, "scene file (TOML), e.g. suites/scenes/ring.toml")->required();
   run_cmd->add_option("--set", run.overrides, "override a scene key: --set cells=128 (repeatable)")
       ->allow_extra_args(false)
@@ -49,7 +50,8 @@ int main(int argc, char** argv) {
   CLI::App* suite_cmd = app.add_subcommand(
       "suite", "Run every case of a suite, each in a process of its own; resumable; shares cases over MPI ranks under "
                "mpirun.\nExit status: 0 every case completed, lost its solution or was stopped by the solver, 1 a case "
-               "crashed, timed out or was refused, 2 bad input (also: another suite running in DIR, or DIR holding "
+               "crashed, timed out or was refused (or the suite could not write its own files: a full disk; rerun to "
+               "resume), 2 bad input (also: another suite running in DIR, or DIR holding "
                "another suite's results without --force), 130 interrupted (rerun to resume).");
   suite_cmd->add_option("suite", suite.suite_file, "suite file (TOML), e.g. suites/ring-quick.toml")->required();
   suite_cmd->add_option("-j,--jobs", suite.jobs, "cases at once (per MPI rank)")->check(CLI::Range(1, 1024));
