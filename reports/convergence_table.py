@@ -8,13 +8,12 @@ rounding alone can explain it, and the ratio measures the rounding).
 
 Usage: /usr/bin/python3 reports/convergence_table.py RESULTS.h5 [RESULTS.h5 ...]
 """
-import math
 import sys
 
 import h5py
 
 from results import read_results_file
-from series import error_at_roundoff
+from series import pair_order_cell
 
 # The /errors columns tabulated, by their heading.
 NORMS = {"L1 Theta=0": "L1_theta0", "L1 +45": "L1_theta_plus45", "L1 -45": "L1_theta_minus45",
@@ -39,19 +38,6 @@ def read_case(path):
         }
 
 
-def observed_order(e_coarse, e_fine, h_coarse, h_fine):
-    if e_coarse <= 0 or e_fine <= 0:
-        return float("nan")
-    return math.log(e_coarse / e_fine) / math.log(h_coarse / h_fine)
-
-
-def order_cell(coarse, fine, heading, time, e_coarse, e_fine):
-    """The observed order between two meshes, or "round-off" when either error is at round-off."""
-    if any(error_at_roundoff(c["case"], NORMS[heading], time, e) for c, e in ((coarse, e_coarse), (fine, e_fine))):
-        return f"{'round-off':>9}"
-    return f"{observed_order(e_coarse, e_fine, coarse['h'], fine['h']):>9.2f}"
-
-
 def main(paths):
     if not paths:
         print(__doc__.strip(), file=sys.stderr)
@@ -71,7 +57,8 @@ def main(paths):
             values = [c["norms"][norm][k] if k < len(c["time"]) else float("nan") for c in cases]
             row = f"{t:>7.3g}" + "".join(f" {v:>12.4e}" for v in values)
             for a, b in zip(range(len(cases) - 1), range(1, len(cases))):
-                row += " " + order_cell(cases[a], cases[b], norm, t, values[a], values[b])
+                row += " " + pair_order_cell((cases[a]["case"], cases[b]["case"]), NORMS[norm], t,
+                                             (values[a], values[b]), (cases[a]["h"], cases[b]["h"]))
             print(row)
     return 0
 

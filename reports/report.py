@@ -37,7 +37,7 @@ import references
 from results import (SuiteDirectoryError, lookup_error, read_contact_pressure, read_error_spectrum, read_monitors,
                      read_point_history, read_probe_lines, read_scene_history, read_suite, relative_energy_created)
 from series import (DEFAULT_REFINE_KEY, at_roundoff, refined_size, refinement_series, roundoff_checks,
-                    roundoff_text, series_levels, size_name, usable)
+                    roundoff_text, series_levels, size_name, steps_of, usable)
 
 ORDERS_CSV_COLUMNS = (
     ("study", "the study"),
@@ -224,9 +224,7 @@ def point_changes_at_roundoff(cases, history, values):
         size = float(np.hypot(position[0], position[1]))
     else:
         return False
-    steps = [c.attribute("steps", 0) for c in cases]
-    steps = max((int(n) for n in steps if isinstance(n, (int, float)) and math.isfinite(n)), default=0)
-    floor = orders.roundoff_floor(steps, size)
+    floor = orders.roundoff_floor(max((steps_of(c) for c in cases), default=0), size)
     return any(abs(coarse - fine) <= floor for coarse, fine in zip(values, values[1:]))
 
 

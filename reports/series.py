@@ -18,7 +18,7 @@ import json
 import math
 from dataclasses import dataclass
 
-from orders import roundoff_floor
+from orders import pairwise_orders, roundoff_floor
 from results import error_scale, lookup_error
 
 DEFAULT_REFINE_KEY = "cells"
@@ -202,10 +202,23 @@ def roundoff_checks(levels, norm, time=None):
     for level in usable(levels):
         case = level.case
         scale = error_scale(case, norm, case.end_time if time is None else float(time))
-        steps = case.attribute("steps", 0)
-        steps = int(steps) if isinstance(steps, (int, float)) and math.isfinite(steps) else 0
-        checks.append(None if scale is None else RoundOff(level, scale[0], roundoff_floor(steps, scale[1])))
+        checks.append(None if scale is None else RoundOff(level, scale[0], roundoff_floor(steps_of(case), scale[1])))
     return checks
+
+
+def steps_of(case):
+    """The steps the case's run took (its attribute `steps`), 0 where not known."""
+    steps = case.attribute("steps", 0)
+    return int(steps) if isinstance(steps, (int, float)) and math.isfinite(steps) else 0
+
+
+def pair_order_cell(cases, norm, time, errors, sizes, width=9):
+    """A table cell with the observed order between two levels (coarse, fine: their
+    cases, errors of `norm` at output time `time`, and sizes h), or "round-off" in
+    its place when either error is at round-off (RoundOff)."""
+    if any(error_at_roundoff(case, norm, time, error) for case, error in zip(cases, errors)):
+        return f"{'round-off':>{width}}"
+    return f"{pairwise_orders(list(sizes), list(errors))[0]:>{width}.2f}"
 
 
 def error_at_roundoff(case, norm, time, error):

@@ -11,14 +11,13 @@ Without --times: the scene's end time. Without --norms: the first probe line's
 L1 (eq. 3.1 of 000_1dbcb8acb6dddab9.txt) and the particle L2 norm.
 """
 import argparse
-import math
 import sys
 from collections import defaultdict
 
 import h5py
 
 from results import read_results_file
-from series import error_at_roundoff
+from series import pair_order_cell
 
 METHOD_ORDER = {"linear": 0, "gimp": 1, "cpdi": 2, "cpdi-exact": 3, "bspline": 4, "bspline-cubic": 5}
 
@@ -63,21 +62,14 @@ def read_case(path, times, norms):
         }
 
 
-def order(coarse, fine, key):
-    a, b = coarse["values"].get(key, float("nan")), fine["values"].get(key, float("nan"))
-    if a > 0 and b > 0 and coarse["h"] != fine["h"]:
-        return math.log(a / b) / math.log(coarse["h"] / fine["h"])
-    return float("nan")
-
-
 def order_cell(coarse, fine, key):
     """The order between two meshes (blank for the first), or "round-off" when either error is at round-off."""
     if coarse is None:
         return f"{float('nan'):>9.2f}"
     norm, time = key
-    if any(error_at_roundoff(c["case"], norm, time, c["values"].get(key, float("nan"))) for c in (coarse, fine)):
-        return f"{'round-off':>9}"
-    return f"{order(coarse, fine, key):>9.2f}"
+    return pair_order_cell((coarse["case"], fine["case"]), norm, time,
+                           tuple(c["values"].get(key, float("nan")) for c in (coarse, fine)),
+                           (coarse["h"], fine["h"]))
 
 
 def main(argv):

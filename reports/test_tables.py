@@ -6,6 +6,7 @@ import math
 
 import convergence_table
 import study_table
+from orders import pairwise_orders
 from conftest import ROUNDOFF_SUITE, roundoff_cases, write_ring_results, write_suite_directory
 
 
@@ -13,7 +14,7 @@ def test_observed_order_of_c_h_squared_is_two():
     h = [0.1, 0.05, 0.025]
     e = [3.0 * x * x for x in h]
     for a, b in zip(range(2), range(1, 3)):
-        assert math.isclose(convergence_table.observed_order(e[a], e[b], h[a], h[b]), 2.0, rel_tol=1e-12)
+        assert math.isclose(pairwise_orders([h[a], h[b]], [e[a], e[b]])[0], 2.0, rel_tol=1e-12)
 
 
 def test_convergence_table_prints_order_two(second_order_series, capsys):
