@@ -45,8 +45,8 @@ from dataclasses import dataclass
 
 from orders import OrderFit, least_squares_order
 from results import SuiteDirectoryError, exact_signal_fraction, read_suite
-from series import (DEFAULT_REFINE_KEY, Series, at_roundoff, matches, refinement_series, roundoff_checks,
-                    roundoff_text, series_levels, size_name, usable)
+from series import (DEFAULT_REFINE_KEY, Series, floor_kind, floor_text, matches, refinement_series,
+                    roundoff_checks, series_levels, size_name, usable)
 
 NUMBER = (int, float)
 EXPECT_KEYS = {
@@ -70,7 +70,7 @@ class Verdict:
     reasons: tuple              # why it fell short; empty when it holds
     notes: tuple                # levels left out of a passing fit, an interval reaching outside the band
     warnings: tuple = ()        # a read where the exact signal is trivial (TRIVIAL_SIGNAL)
-    roundoff: bool = False      # some usable level's error is at round-off: no order is given
+    floor: str = None           # "round-off" or "settling" where some usable level's error is at it: no order is given
 
     @property
     def passed(self):
@@ -131,10 +131,11 @@ def check_series(number, expect, series):
     good = usable(levels)
     fit = least_squares_order([l.h for l in good], [l.error for l in good])
     has_order = "order" in expect
-    # An order fitted through a level whose error rounding alone can explain
-    # measures the rounding: such an order is never passed (reports/orders.py).
+    # An order fitted through a level whose error rounding, or the solver's
+    # settling short of the static state, alone can explain measures that: such
+    # an order is never passed (reports/orders.py).
     checks = roundoff_checks(levels, expect["norm"], expect.get("time")) if has_order else []
-    roundoff = bool(at_roundoff(checks))
+    floor = floor_kind(checks)
     order = float(expect["order"]) if has_order else float("nan")
     tolerance = float(expect["tolerance"]) if has_order else float("nan")
     constant = max((l.error / l.h ** order for l in good), default=float("nan")) if has_order else float("nan")
@@ -164,13 +165,13 @@ def check_series(number, expect, series):
                            + ": no order can be fitted (does the run measure this norm?)")
         else:
             reasons.append(f"{size_name(series.refine).split(' [')[0]} does not vary over the usable levels: no order")
-    elif roundoff:
-        reasons.append(f"errors at round-off {roundoff_text(series.refine, checks)}: no order can be observed; "
+    elif floor:
+        reasons.append(f"errors at {floor_text(series.refine, checks)}: no order can be observed; "
                        "check max_error instead")
     elif not order - tolerance <= fit.order <= order + tolerance:
         reasons.append(f"order {fit.order:.3f} outside [{order - tolerance:g}, {order + tolerance:g}]")
     interval_notes = []
-    if has_order and math.isfinite(fit.order) and not roundoff:
+    if has_order and math.isfinite(fit.order) and not floor:
         band = f"[{order - tolerance:g}, {order + tolerance:g}]"
         inside = order - tolerance <= fit.ci_low and fit.ci_high <= order + tolerance
         if expect.get("interval_within_band", False):
@@ -201,7 +202,7 @@ def check_series(number, expect, series):
         warnings = (f"warning: read where the exact signal is {100 * min(fractions):.3g} % of its largest "
                     f"(a run without the motion would score nearly the same)",)
     return Verdict(number, expect, series, tuple(levels), fit, constant, tuple(reasons), tuple(notes), warnings,
-                   roundoff)
+                   floor)
 
 
 def _level_outcome(series, level):
@@ -235,10 +236,10 @@ def verdict_row(verdict):
     expect = verdict.expectation
     fit = verdict.fit
     # An expectation on the error alone (max_error, for errors at round-off or
-    # settling level) claims no order, and a series at round-off has none: none
+    # settling level) claims no order, and a series at either has none: none
     # is shown beside them.
-    shown = "order" in expect and math.isfinite(fit.order) and not verdict.roundoff
-    observed = f"{fit.order:.3f}" if shown else "- (round-off)" if verdict.roundoff else "-"
+    shown = "order" in expect and math.isfinite(fit.order) and not verdict.floor
+    observed = f"{fit.order:.3f}" if shown else f"- ({verdict.floor})" if verdict.floor else "-"
     if shown and math.isfinite(fit.ci_low):
         observed += f" [{fit.ci_low:.2f}, {fit.ci_high:.2f}]"
     used = [str(l.value) for l in verdict.levels if not l.reason]

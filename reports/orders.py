@@ -21,6 +21,12 @@ Classification of a range (the rule, applied in this order):
 * ``round-off``: the error of some usable level is positive and at most its
   round-off floor (below): rounding alone can explain it, so the levels' ratios
   measure the rounding, not the method, and no order is given;
+* ``settling``: the run settles to a static state (dynamic relaxation, implicit
+  load steps), and the error of some usable level is positive and at most what
+  the run's distance from that state at the end could leave in the norm
+  (results.py: settling_scale, from the results file's settling_displacement
+  and settling_strain): the solver's stopping point can explain it, and no
+  order is given;
 * ``stalled``: the last pairwise order (between the two finest levels) is below
   STALLED_BELOW = 0.5: the error no longer falls with h;
 * ``non-asymptotic``: the pairwise orders span more than ASYMPTOTIC_SPREAD = 0.5
@@ -138,14 +144,15 @@ def roundoff_floor(steps, size):
     return (ROUNDOFF_ULPS + max(steps, 0)) * sys.float_info.epsilon * size
 
 
-def classify(pairwise, roundoff=False):
-    """The class of a refinement range from its pairwise orders and whether some
-    level's error is at round-off (rule in the module docstring)."""
+def classify(pairwise, floor=None):
+    """The class of a refinement range from its pairwise orders and what may
+    explain some level's error other than the method, "round-off" or
+    "settling" (series.floor_kind; None: nothing), rule in the module docstring."""
     finite = [p for p in pairwise if math.isfinite(p)]
     if not pairwise or not finite:
         return "too few levels"
-    if roundoff:
-        return "round-off"
+    if floor:
+        return floor
     if not math.isfinite(pairwise[-1]) or pairwise[-1] < STALLED_BELOW:
         return "stalled"
     if len(finite) < 2:

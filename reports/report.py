@@ -36,8 +36,8 @@ import orders
 import references
 from results import (SuiteDirectoryError, lookup_error, read_contact_pressure, read_error_spectrum, read_monitors,
                      read_point_history, read_probe_lines, read_scene_history, read_suite, relative_energy_created)
-from series import (DEFAULT_REFINE_KEY, at_roundoff, refined_size, refinement_series, roundoff_checks,
-                    roundoff_text, series_levels, size_name, steps_of, usable)
+from series import (DEFAULT_REFINE_KEY, floor_kind, floor_text, refined_size, refinement_series, roundoff_checks,
+                    series_levels, size_name, steps_of, usable)
 
 ORDERS_CSV_COLUMNS = (
     ("study", "the study"),
@@ -54,7 +54,7 @@ ORDERS_CSV_COLUMNS = (
     ("ls_order", "least-squares order (NaN at round-off)"),
     ("ci_low", "lower end of its 95% Student-t interval (NaN with two levels or at round-off)"),
     ("ci_high", "upper end"),
-    ("classification", "round-off, asymptotic, non-asymptotic, stalled, unchecked (2 levels) or too few levels"),
+    ("classification", "round-off, settling, asymptotic, non-asymptotic, stalled, unchecked (2 levels) or too few levels"),
     ("finest_level", "refine value of the finest usable level"),
     ("finest_h", "its size (as h)"),
     ("finest_error", "its error"),
@@ -64,6 +64,9 @@ ORDERS_CSV_COLUMNS = (
     ("roundoff_floor", "each usable level's round-off floor, (256 + steps) ulps of the numbers the error is a "
                        "difference of, over the same signal: a level whose relative_error is at most this is at "
                        "round-off (reports/orders.py)"),
+    ("settling", "each usable level's settling level over the same signal, the largest error the run's distance "
+                 "from its static state at the end could leave (results.py: settling_scale; NaN for a run that "
+                 "does not settle): a level whose relative_error is at most this is at the settling level"),
 )
 METHOD_KEYS = ("method", "scheme", "particles_per_direction", "cfl", "time_integration", "solver", "load_steps",
                "dilatation", "formulation")
@@ -92,8 +95,9 @@ class OrderRow:
 
     @property
     def has_order(self):
-        """False for a series at round-off: its fitted numbers measure the rounding."""
-        return self.classification != "round-off"
+        """False for a series at round-off or at the settling level: its fitted
+        numbers measure the rounding, or how far the solver stopped short."""
+        return self.classification not in ("round-off", "settling")
 
 
 @dataclass(frozen=True)
@@ -151,7 +155,7 @@ def order_row(series, norm, unit, time, at_end):
     checks = roundoff_checks(good, norm, time) if len(good) >= 2 else []
     return OrderRow(series.study, series, norm, unit, time, at_end, tuple(good),
                     tuple(l for l in levels if l.reason), tuple(pairwise),
-                    orders.least_squares_order(h, error), orders.classify(pairwise, bool(at_roundoff(checks))),
+                    orders.least_squares_order(h, error), orders.classify(pairwise, floor_kind(checks)),
                     tuple(checks))
 
 
@@ -308,8 +312,8 @@ def error_figure(study, norm, time, rows, styles, quantities, directory):
         return None
     times = sorted({r.time for r in chosen})
     when = time_text(times[0]) if len(times) == 1 else "the end time"
-    # A series at round-off is drawn without a fit, and its legend says why.
-    curves = [figures.Curve(r.series.label if r.has_order else f"{r.series.label}: round-off, no order",
+    # A series at round-off or at the settling level is drawn without a fit, and its legend says why.
+    curves = [figures.Curve(r.series.label if r.has_order else f"{r.series.label}: {r.classification}, no order",
                             [l.h for l in r.levels], [l.error for l in r.levels], styles[r.series.label],
                             r.fit if r.has_order else None) for r in chosen]
     unit = chosen[0].unit
@@ -323,8 +327,8 @@ def error_figure(study, norm, time, rows, styles, quantities, directory):
                f"fits those, as the verdict's levels column says); grey: slopes 1 and 2.")
     at_floor = [r for r in chosen if not r.has_order]
     if at_floor:
-        caption += " No order, errors at round-off: " + "; ".join(
-            f"{r.series.label} {roundoff_text(r.series.refine, r.roundoff)}" for r in at_floor) + "."
+        caption += " No order, errors at " + "; ".join(
+            f"{floor_text(r.series.refine, r.roundoff)} ({r.series.label})" for r in at_floor) + "."
     if missing:
         caption += f" No usable level: {'; '.join(missing)}."
     return FigureEntry(study, path, caption)
@@ -868,7 +872,7 @@ def order_cells(row):
             number(finest.error) if finest else "-",
             (", ".join(number(p, ".2f") for p in row.pairwise) if row.has_order else "") or "-",
             (number(fit.order, ".3f") + ci) if shown else "-",
-            row.classification if row.has_order else f"round-off {roundoff_text(row.series.refine, row.roundoff)}"]
+            row.classification if row.has_order else floor_text(row.series.refine, row.roundoff)]
 
 
 def orders_table(rows):
@@ -926,7 +930,8 @@ def write_orders_csv(rows, path):
                              repr(finest.error) if finest else "",
                              ";".join(f"{l.value}: {l.reason}" for l in r.left_out),
                              _joined(_per_level(r, lambda c: c.relative_error)),
-                             _joined(_per_level(r, lambda c: c.relative_floor))])
+                             _joined(_per_level(r, lambda c: c.relative_floor)),
+                             _joined(_per_level(r, lambda c: c.relative_settling))])
 
 
 def write_gci_csv(rows, path):

@@ -11,7 +11,7 @@ lost (the results file's health verdict, reports/results-format.md), and it
 counts as not completed everywhere. A case without a readable results file (pending, crashed, timeout,
 error, or a damaged file) is kept with ``results = None`` and a note saying why,
 so that every report and the gate can show it instead of stopping on it.
-Only root attributes, /errors and the /measurements scalars are read up front;
+Only root attributes, /errors and the /measurements and /settling scalars are read up front;
 probe arrays (lines, points, the circle, /probes/contact_pressure,
 /probes/history, /probes/monitors) are read on demand for the cases that are
 plotted.
@@ -42,6 +42,7 @@ class CaseResults:
     errors: dict                  # /errors column name -> values at error_times
     line_quantities: dict         # probe line name -> its 'quantity' attribute
     measurements: dict = field(default_factory=dict)   # /measurements attributes: name -> value
+    settling: dict = field(default_factory=dict)       # /settling attributes, its norms under "norms"
 
 
 @dataclass(frozen=True)
@@ -211,7 +212,7 @@ def _plain(value):
 
 def read_case_results(path):
     """Root attributes, /errors, the probe lines' quantities and the /measurements
-    attributes of one results file."""
+    and /settling attributes of one results file."""
     with h5py.File(path, "r") as f:
         attributes = {name: _plain(value) for name, value in f.attrs.items()}
         errors_group = f.get("errors")
@@ -232,7 +233,14 @@ def read_case_results(path):
         measurements_group = f.get("measurements")
         measurements = ({name: _plain(value) for name, value in measurements_group.attrs.items()}
                         if isinstance(measurements_group, h5py.Group) else {})
-    return CaseResults(attributes, error_times, errors, line_quantities, measurements)
+        settling_group = f.get("settling")
+        settling = {}
+        if isinstance(settling_group, h5py.Group):
+            settling = {name: _plain(value) for name, value in settling_group.attrs.items()}
+            norms_group = settling_group.get("norms")
+            settling["norms"] = ({name: _plain(value) for name, value in norms_group.attrs.items()}
+                                 if isinstance(norms_group, h5py.Group) else {})
+    return CaseResults(attributes, error_times, errors, line_quantities, measurements, settling)
 
 
 def lookup_error(case, norm, time):
@@ -426,6 +434,65 @@ def error_scale(case, norm, time):
     if size is None or not math.isfinite(signal[index]):
         return None
     return float(signal[index]), size
+
+
+# A mean over a region of at least a quarter of the body is at most twice the
+# body's RMS (settling_scale).
+SETTLING_REGION_FACTOR = 2.0
+
+
+def settling_scale(case, norm, time):
+    """The largest error in `norm` that the run's stopping short of its static
+    state could leave at output time `time`, in the norm's unit, from the
+    results file's /settling group (results-format.md); None for a run that
+    does not settle, a read before the end (settling is the end's) or a norm it
+    does not translate to.
+
+    A damped run that relaxes (method "relaxation") gives each norm read at the
+    end its own: how much it would still change. Load steps that each end in
+    equilibrium (method "newton") give the Newton correction left, delta
+    (displacement: mass-weighted RMS over the grid) and the RMS of its strain
+    over the body; a particle's displacement is a convex combination of the
+    nodes', so over the N particles its RMS, and its mean, is at most delta
+    (particle_L2, particle_L1); over k of them (a probe line's points, counted
+    as particles of the mean mass; the one of particle_Linf) at most delta
+    sqrt(N / k); an error_* column of a strain, stretch or stress (relative to
+    its exact value, a mean over a region of the body) at most
+    SETTLING_REGION_FACTOR x the strain's RMS over the strain's size, the
+    largest |F - I| entry of the particles."""
+    if case.results is None or not case.results.settling:
+        return None
+    if _output_index(np.asarray([case.end_time]), float(time), 1) is None:
+        return None
+    settling = case.results.settling
+
+    def finite(value):
+        return float(value) if isinstance(value, (int, float)) and math.isfinite(value) and value >= 0.0 else None
+
+    if settling.get("method") == "relaxation":
+        return finite(settling.get("norms", {}).get(norm))
+    delta, strain_error = finite(settling.get("displacement")), finite(settling.get("strain"))
+    particles = case.attribute("particle_count")
+    counted = isinstance(particles, (int, float)) and particles >= 1
+    if norm in ("particle_L1", "particle_L2"):
+        return delta
+    if delta is not None and counted and norm == "particle_Linf":
+        return delta * math.sqrt(particles)
+    if delta is not None and counted and norm.startswith("L1_"):
+        try:
+            line = next((l for l in read_probe_lines(case.results_path) if l.name == norm[3:]), None)
+        except (OSError, KeyError, ValueError, TypeError):
+            return None
+        # A length: the displacements' components, not an angle or a pressure.
+        if line is None or "displacement" not in line.quantity or "angular" in line.quantity \
+                or line.exact.shape[-1] == 0:
+            return None
+        return delta * math.sqrt(particles / line.exact.shape[-1])
+    if strain_error is not None and norm.startswith(RELATIVE_NORM_PREFIX) \
+            and norm.endswith(("_strain", "_stretch", "_stress")):
+        strain = _strain_size(case)
+        return None if strain is None else SETTLING_REGION_FACTOR * strain_error / strain
+    return None
 
 
 def read_point_history(path):

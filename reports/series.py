@@ -19,7 +19,7 @@ import math
 from dataclasses import dataclass
 
 from orders import pairwise_orders, roundoff_floor
-from results import error_scale, lookup_error
+from results import error_scale, lookup_error, settling_scale
 
 DEFAULT_REFINE_KEY = "cells"
 
@@ -172,13 +172,20 @@ def usable(levels):
     return [level for level in levels if not level.reason]
 
 
+# What may explain a level's error other than the method (RoundOff.floor_kind).
+ROUNDOFF, SETTLING = "round-off", "settling"
+
+
 @dataclass(frozen=True)
 class RoundOff:
-    """A usable level's error beside the exact signal it measures at the read time
-    and the largest error rounding alone can leave there (reports/orders.py)."""
+    """A usable level's error beside the exact signal it measures at the read time,
+    the largest error rounding alone can leave there (reports/orders.py) and,
+    for a run that settles to a static state, the largest its distance from
+    that state at the end can leave (results.settling_scale; None otherwise)."""
     level: Level
-    signal: float         # S, in the norm's unit (1 for an error relative to its exact value)
+    signal: float         # S, in the norm's unit (1 for an error relative to its exact value; NaN: not known)
     floor: float          # orders.roundoff_floor(the case's steps, M)
+    settling: float = None
 
     @property
     def relative_error(self):
@@ -189,20 +196,42 @@ class RoundOff:
         return self.floor / self.signal if self.signal > 0 else float("inf")
 
     @property
+    def relative_settling(self):
+        if self.settling is None:
+            return float("nan")
+        return self.settling / self.signal if self.signal > 0 else float("inf")
+
+    @property
     def at_roundoff(self):
         # An error of exactly zero is not rounding: the gate asks whether the run measures the norm.
         return 0.0 < self.level.error <= self.floor
+
+    @property
+    def at_settling(self):
+        return self.settling is not None and 0.0 < self.level.error <= self.settling
+
+    @property
+    def floor_kind(self):
+        """ROUNDOFF, SETTLING (where rounding does not already explain the error), or None."""
+        return ROUNDOFF if self.at_roundoff else SETTLING if self.at_settling else None
 
 
 def roundoff_checks(levels, norm, time=None):
     """One RoundOff per usable level of `levels`, in order, at output time `time`
     (default: the case's end time); None for a level whose exact signal or
-    coordinate size is not known (results.error_scale)."""
+    coordinate size is not known (results.error_scale) and that does not settle
+    (results.settling_scale)."""
     checks = []
     for level in usable(levels):
         case = level.case
-        scale = error_scale(case, norm, case.end_time if time is None else float(time))
-        checks.append(None if scale is None else RoundOff(level, scale[0], roundoff_floor(steps_of(case), scale[1])))
+        at = case.end_time if time is None else float(time)
+        scale, settling = error_scale(case, norm, at), settling_scale(case, norm, at)
+        if scale is not None:
+            checks.append(RoundOff(level, scale[0], roundoff_floor(steps_of(case), scale[1]), settling))
+        elif settling is not None:
+            checks.append(RoundOff(level, float("nan"), 0.0, settling))
+        else:
+            checks.append(None)
     return checks
 
 
@@ -214,32 +243,50 @@ def steps_of(case):
 
 def pair_order_cell(cases, norm, time, errors, sizes, width=9):
     """A table cell with the observed order between two levels (coarse, fine: their
-    cases, errors of `norm` at output time `time`, and sizes h), or "round-off" in
-    its place when either error is at round-off (RoundOff)."""
-    if any(error_at_roundoff(case, norm, time, error) for case, error in zip(cases, errors)):
-        return f"{'round-off':>{width}}"
+    cases, errors of `norm` at output time `time`, and sizes h), or what explains
+    either error in its place ("round-off", "settling": RoundOff.floor_kind)."""
+    kinds = [error_floor_kind(case, norm, time, error) for case, error in zip(cases, errors)]
+    kind = ROUNDOFF if ROUNDOFF in kinds else SETTLING if SETTLING in kinds else None
+    if kind:
+        return f"{kind:>{width}}"
     return f"{pairwise_orders(list(sizes), list(errors))[0]:>{width}.2f}"
 
 
-def error_at_roundoff(case, norm, time, error):
-    """True when `error`, the case's `norm` at output time `time`, is at round-off
-    (RoundOff), for tables that compare single results files."""
+def error_floor_kind(case, norm, time, error):
+    """What may explain `error`, the case's `norm` at output time `time`, other
+    than the method (RoundOff.floor_kind), for tables that compare single results
+    files."""
     [check] = roundoff_checks([Level(case, None, case.h, error, "")], norm, time)
-    return check is not None and check.at_roundoff
+    return None if check is None else check.floor_kind
 
 
-def at_roundoff(checks):
-    """The checks whose level's error is at round-off."""
-    return [c for c in checks if c is not None and c.at_roundoff]
+def at_floor(checks):
+    """The checks whose level's error is at round-off or at the settling level."""
+    return [c for c in checks if c is not None and c.floor_kind]
 
 
-def roundoff_text(refine, checks):
-    """Which levels among `checks` are at round-off and how small their errors are
-    ("at cells=88 (up to 9.4e-08 of the exact signal; round-off floor 9.5e-08)"),
-    for a report cell or a gate reason; "" when none is."""
-    at = at_roundoff(checks)
-    if not at:
+def floor_kind(checks):
+    """ROUNDOFF when some level's error is at round-off, else SETTLING when some
+    level's is at the settling level, else None: the series' class then, and no
+    order is given."""
+    kinds = [c.floor_kind for c in checks if c is not None]
+    return ROUNDOFF if ROUNDOFF in kinds else SETTLING if SETTLING in kinds else None
+
+
+def floor_text(refine, checks):
+    """Which levels among `checks` are at a floor and how small their errors are
+    ("round-off at cells=88 (up to 9.4e-08 of the exact signal; round-off floor
+    9.5e-08)", "the settling level at cells=44,88 (...)"), for a report cell or
+    a gate reason; "" when none is."""
+    kind = floor_kind(checks)
+    if kind is None:
         return ""
-    largest = max(at, key=lambda c: c.relative_error)
-    return (f"at {refine}={','.join(str(c.level.value) for c in at)} (up to {largest.relative_error:.2g} of the "
-            f"exact signal; round-off floor {largest.relative_floor:.2g})")
+    at = [c for c in checks if c is not None and c.floor_kind == kind]
+    levels = ",".join(str(c.level.value) for c in at)
+    if kind == ROUNDOFF:
+        largest = max(at, key=lambda c: c.relative_error)
+        return (f"round-off at {refine}={levels} (up to {largest.relative_error:.2g} of the exact signal; "
+                f"round-off floor {largest.relative_floor:.2g})")
+    ratio = max(c.settling / c.level.error for c in at)
+    return (f"the settling level at {refine}={levels} (the run's distance from its static state at the end "
+            f"could leave up to {ratio:.2g} times the error: results settling_displacement, settling_strain)")

@@ -117,6 +117,7 @@ def test_a_range_with_a_level_at_round_off_has_no_order_class():
     assert orders.roundoff_floor(100, math.pi) == pytest.approx(356 * eps * math.pi, rel=1e-15)
     assert orders.roundoff_floor(0, 0.03) == pytest.approx(256 * eps * 0.03, rel=1e-15)
     exact_h2 = orders.pairwise_orders(H[:3], [4e-13, 1e-13, 2.5e-14])
-    assert orders.classify(exact_h2, roundoff=True) == "round-off"
+    assert orders.classify(exact_h2, "round-off") == "round-off"
+    assert orders.classify(exact_h2, "settling") == "settling"
     assert orders.classify(exact_h2) == "asymptotic"
-    assert orders.classify([], roundoff=True) == "too few levels"
+    assert orders.classify([], "round-off") == "too few levels"

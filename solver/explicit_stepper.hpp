@@ -23,6 +23,14 @@ struct ParticleFault {
   std::string detail;  // values that show it
 };
 
+// How far a body settling to a static state still is from it: the RMS over
+// the body of the displacement still to come [m], and of the change of the
+// deformation gradient F still to come (Frobenius; dimensionless).
+struct Settling {
+  double displacement = std::numeric_limits<double>::quiet_NaN();
+  double strain = std::numeric_limits<double>::quiet_NaN();
+};
+
 class Stepper {
  public:
   virtual ~Stepper() = default;
@@ -64,6 +72,11 @@ class Stepper {
   virtual std::string step_failure() const { return {}; }
   // Counters of the stepper's own (Newton and Krylov iterations), for the results file.
   virtual std::vector<std::pair<std::string, double>> statistics() const { return {}; }
+  // For a scene that settles to a static state by load steps that each end in
+  // equilibrium (the implicit step): how far the last one still is from it
+  // (Settling), from the body's small-strain shear modulus; NaN for a stepper
+  // that settles by relaxing in time (the scene measures that itself).
+  virtual Settling distance_to_equilibrium(double /*shear_modulus*/) const { return {}; }
   // The run's health now (monitors.hpp), and the work done on it so far.
   virtual Monitors monitors() const = 0;
   // The largest frequency omega_max [rad/s] of the grid's motion linearized

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -28,6 +29,12 @@ struct NodeMap {
   int dof[2] = {-1, -1};
   Vec2 direction[2] = {Vec2::Zero(), Vec2::Zero()};
   Vec2 base = Vec2::Zero();
+};
+
+// What one more Newton iteration would still move (StaticStepper::remaining_correction).
+struct Remaining {
+  double displacement = std::numeric_limits<double>::quiet_NaN();  // mass-weighted RMS of K^-1 R [m]
+  double energy = std::numeric_limits<double>::quiet_NaN();        // R^T K^-1 R, the energy norm squared
 };
 
 // Couplings a particle makes between nodes at most this many cells apart
@@ -91,6 +98,7 @@ class StaticStepper final : public Stepper {
       }
     }
     newton_iterations_ += result.iterations;
+    if (result.converged) remaining_ = remaining_correction(shape, q, result.preconditioner_setups > 0);
     linear_iterations_ += result.linear_iterations;
     residual_evaluations_ += result.residual_evaluations;
     ++solves_;
@@ -103,6 +111,16 @@ class StaticStepper final : public Stepper {
   }
 
   std::string step_failure() const override { return failure_; }
+
+  // The last solve's remaining Newton correction c (remaining_correction). Its
+  // strain e over the body: c . R = c^T K c is the strain energy of c, and
+  // small-strain elasticity stores at least mu |e|^2 per volume (lambda >= 0),
+  // so the RMS of |e| over the body's volume V is at most sqrt(c . R / (2 mu V))
+  // (energy per unit depth, twice the stored energy).
+  Settling distance_to_equilibrium(double shear_modulus) const override {
+    const double volume = std::accumulate(model_.particles.volume.begin(), model_.particles.volume.end(), 0.0);
+    return {remaining_.displacement, std::sqrt(remaining_.energy / (2.0 * shear_modulus * volume))};
+  }
 
   std::vector<std::pair<std::string, double>> statistics() const override {
     return {{"implicit_solves", double(solves_)},
@@ -357,6 +375,35 @@ class StaticStepper final : public Stepper {
     return solve_newton_krylov(problem, q, o);
   }
 
+  // How far the solution q still is from equilibrium: the Newton correction
+  // c = K^-1 R(q) one more iteration would start from, K the preconditioner's
+  // tangent; its mass-weighted RMS over the nodes [m] and its energy norm
+  // squared, c . R (Newton's error after its last step is of the order of
+  // that step's square, so the last step taken is no such estimate; the mass
+  // weights leave out the nodes particles barely reach, whose stiffness is the
+  // factorization's regularization). A solve that took no iteration never set
+  // the tangent up.
+  Remaining remaining_correction(const Shape& shape, const std::vector<double>& q, bool tangent_set) {
+    std::vector<double> r(q.size());
+    residual(shape, q, r);
+    if (!tangent_set) assemble(shape);
+    const Eigen::Map<const Eigen::VectorXd> R(r.data(), Eigen::Index(r.size()));
+    const Eigen::VectorXd c = factor_.solve(R);
+    double weighted = 0.0, mass = 0.0;
+    for (std::size_t i = 0; i < map_.size(); ++i) {
+      if (!(fields_.mass[i] > 0.0)) continue;
+      Vec2 v = Vec2::Zero();
+      for (int k = 0; k < 2; ++k)
+        if (map_[i].dof[k] >= 0) v += c[map_[i].dof[k]] * map_[i].direction[k];
+      weighted += fields_.mass[i] * v.squaredNorm();
+      mass += fields_.mass[i];
+    }
+    Remaining out;
+    if (mass > 0.0) out.displacement = std::sqrt(weighted / mass);
+    out.energy = std::abs(c.dot(R));
+    return out;
+  }
+
   // ------------------------------------------------------------ contact
 
   // After a solve: nodes whose contact force pulls are released, nodes that
@@ -481,6 +528,7 @@ class StaticStepper final : public Stepper {
   std::string failure_;
   long newton_iterations_ = 0, linear_iterations_ = 0, residual_evaluations_ = 0, solves_ = 0;
   double preconditioner_seconds_ = 0.0;
+  Remaining remaining_;
 };
 
 template <class Shape>

@@ -29,7 +29,9 @@ struct StaticOptions {
   // uniaxial bar at nu = 0.4999 stop 2500 times less equilibrated: error
   // 2.1e-4 against 2.9e-5 now). Where difference-quotient Jacobian products
   // (good to about sqrt(eps) of the lambda-sized forces) cannot go lower,
-  // KINSOL stops on its step tolerance.
+  // KINSOL stops on its step tolerance. The scene key newton_tolerance sets
+  // it; Stepper::distance_to_equilibrium says how far from equilibrium it
+  // leaves the last step.
   double tolerance = 1e-8;
   long max_iterations = 50;  // Newton iterations per solve
   int max_contact_passes = 30;

@@ -227,7 +227,9 @@ class MmsCase final : public SceneCase, private RunObserver {
 #ifdef MPMVV_HAVE_SUNDIALS
       const double ramp = std::isfinite(setup_.smooth_until) ? setup_.smooth_until : loop_.end_time;
       loop_.fixed_step = ramp / double(config_.integer("load_steps"));
-      stepper_ = make_static_stepper(std::move(model), options_, setup_.material, std::move(stages), StaticOptions{});
+      StaticOptions static_options;
+      static_options.tolerance = config_.real("newton_tolerance");
+      stepper_ = make_static_stepper(std::move(model), options_, setup_.material, std::move(stages), static_options);
 #else
       throw ConfigError("solver = \"implicit\" needs SUNDIALS (built without it: MPMVV_WITH_SUNDIALS=OFF)");
 #endif
@@ -258,6 +260,11 @@ class MmsCase final : public SceneCase, private RunObserver {
     Measurements m;
     if (setup_.measure) m = setup_.measure(RunRecord{point_time_, point_simulated_, *stepper_});
     for (const auto& s : stepper_->statistics()) m.push_back(s);
+    if (settling_) {
+      const Settling s = settling_->measure(outcome_.time_reached, *stepper_);
+      m.push_back({"settling_displacement", s.displacement});
+      m.push_back({"settling_strain", s.strain});
+    }
     if (!monitor_rows_.empty()) {
       // The energy balance at the last output (see record_monitors).
       m.push_back({"energy_created", monitor_rows_.back().created});
@@ -361,6 +368,39 @@ class MmsCase final : public SceneCase, private RunObserver {
     }
     if (setup_.write_extra) setup_.write_extra(probes);
     write_monitors(probes);
+    write_settling(root);
+  }
+
+  // A static scene's distance from its static state at the end (settling.hpp).
+  void write_settling(h5::Group& root) const {
+    if (!settling_ || !stepper_) return;
+    const double end = outcome_.time_reached;
+    const Settling s = settling_->measure(end, *stepper_);
+    h5::Group g = root.create_group("settling");
+    g.set_attribute("description",
+                    settling_->relaxes()
+                        ? "how far the end still is from the static state the damped run relaxes to "
+                          "(tools/app/settling.hpp): what the particles (displacement [m], RMS over the body; strain, "
+                          "RMS of the symmetric part of F's change) and each error norm read at the end (norms, in "
+                          "its unit) moved over the last interval of 1 / decay_rate from kept_time, over "
+                          "exp(decay_rate (end - kept_time)) - 1"
+                        : "how far the end still is from equilibrium: the Newton correction one more iteration of the "
+                          "last load step would make, its mass-weighted RMS over the grid (displacement [m]) and the "
+                          "RMS over the body of its strain, from its energy norm (strain)");
+    g.set_attribute("method", settling_->relaxes() ? "relaxation" : "newton");
+    g.set_attribute("displacement", s.displacement);
+    g.set_attribute("strain", s.strain);
+    if (!settling_->relaxes()) return;
+    g.set_attribute("decay_rate", settling_->decay_rate());
+    g.set_attribute("kept_time", settling_->kept_at());
+    const bool read_at_end = !errors_.time.empty() && std::abs(errors_.time.back() - end) <= 1e-9 * std::max(1.0, end);
+    h5::Group norms = g.create_group("norms");
+    for (const auto& [name, value] : settling_->norm_settling(end, [&](const std::string& column) {
+           const std::vector<double>* values = errors_.find(column);
+           return read_at_end && values && !values->empty() ? values->back()
+                                                            : std::numeric_limits<double>::quiet_NaN();
+         }))
+      norms.set_attribute(name, value);
   }
 
   void write_monitors(h5::Group& probes) const {
@@ -691,6 +731,11 @@ class MmsCase final : public SceneCase, private RunObserver {
     monitor_rows_.clear();
     sampled_motion_ = 0.0;
     stop_ = {};
+    settling_.reset();
+    if (setup_.settling) {
+      settling_.emplace(*setup_.settling, loop_.end_time, !implicit());
+      if (settling_->observe(0.0, s.model().particles)) settling_->keep_norms(settling_norms(0.0, s));
+    }
   }
 
   std::pair<std::string, std::string> stop() const override { return stop_; }
@@ -773,6 +818,7 @@ class MmsCase final : public SceneCase, private RunObserver {
 
   void after_step(double t, const Stepper& s) override {
     if (setup_.exact_motion) sample_motion(t, s.model().particles);
+    if (settling_ && settling_->observe(t, s.model().particles)) settling_->keep_norms(settling_norms(t, s));
     if (setup_.history) {
       const std::vector<double> values = setup_.history(t, s);
       history_time_.push_back(t);
@@ -786,23 +832,51 @@ class MmsCase final : public SceneCase, private RunObserver {
     }
   }
 
+  // Eq. 3.1 on line k at time t: the mean over its material points of
+  // |q_sim - q_exact|; their values into `simulated` and `exact` when given.
+  double line_l1(std::size_t k, const std::vector<Vec2>& tracers, double t, std::vector<double>* simulated = nullptr,
+                 std::vector<double>* exact = nullptr) const {
+    const ProbeLine& line = setup_.lines[k];
+    double l1 = 0.0;
+    for (std::size_t i = 0; i < line.reference.size(); ++i) {
+      const double value = value_at(line.quantity, tracers[line_first_[k] + i], line.reference[i], t);
+      const double expected = exact_at(line.quantity, line.reference[i], t);
+      if (simulated) simulated->push_back(value);
+      if (exact) exact->push_back(expected);
+      l1 += std::abs(value - expected);
+    }
+    return l1 / double(line.reference.size());
+  }
+
+  // The error norms a static scene reads at its end, at time t, for the
+  // settling of each (settling.hpp): the lines' L1, the particle displacement
+  // norms and the scene's own columns.
+  std::vector<std::pair<std::string, double>> settling_norms(double t, const Stepper& s) const {
+    std::vector<std::pair<std::string, double>> norms;
+    for (std::size_t k = 0; k < setup_.lines.size(); ++k)
+      norms.push_back({errors_.columns[k].first, line_l1(k, s.model().tracers, t)});
+    if (setup_.exact_motion) {
+      const DisplacementSums d = displacement_sums(s.model().particles, t);
+      norms.push_back({"particle_L1", d.l1 / d.weight});
+      norms.push_back({"particle_L2", std::sqrt(d.l2 / d.weight)});
+      norms.push_back({"particle_Linf", d.linf});
+    }
+    if (setup_.extra_errors) {
+      const std::vector<double> values = setup_.extra_errors(t, RunRecord{point_time_, point_simulated_, s});
+      for (std::size_t k = 0; k < values.size() && k < setup_.extra_error_names.size(); ++k)
+        norms.push_back({setup_.extra_error_names[k], values[k]});
+    }
+    return norms;
+  }
+
   void at_output(std::size_t, double t, const Stepper& s) override {
     record_monitors(t, s);
     const std::vector<Vec2>& tracers = s.model().tracers;
     output_times_.push_back(t);
     errors_.time.push_back(t);
     for (std::size_t k = 0; k < setup_.lines.size(); ++k) {
-      const ProbeLine& line = setup_.lines[k];
       std::vector<double> sim, ex;
-      double l1 = 0.0;
-      for (std::size_t i = 0; i < line.reference.size(); ++i) {
-        const double value = value_at(line.quantity, tracers[line_first_[k] + i], line.reference[i], t);
-        const double exact = exact_at(line.quantity, line.reference[i], t);
-        sim.push_back(value);
-        ex.push_back(exact);
-        l1 += std::abs(value - exact);
-      }
-      errors_.columns[k].second.push_back(l1 / double(line.reference.size()));  // eq. 3.1
+      errors_.columns[k].second.push_back(line_l1(k, tracers, t, &sim, &ex));
       line_records_[k].simulated.push_back(std::move(sim));
       line_records_[k].exact.push_back(std::move(ex));
     }
@@ -941,6 +1015,7 @@ class MmsCase final : public SceneCase, private RunObserver {
     }
   };
   TimeIntegral integrated_;
+  std::optional<SettlingWatch> settling_;  // a static scene's distance from its static state at the end
 };
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include "mms/force_field.hpp"
 #include "solver/boundary.hpp"
 #include "scene.hpp"
+#include "settling.hpp"
 #ifdef MPMVV_HAVE_CGAL
 #include "body.hpp"
 #endif
@@ -114,6 +115,11 @@ struct ProblemSetup {
   // shows it), used instead of automatic differentiation for speed; absent
   // otherwise.
   std::shared_ptr<mms::ForceField> fast_body_force;
+  // A scene that settles to a static state (problems/quasi_static.hpp): what
+  // the results file's measurements settling_displacement and settling_strain,
+  // how far its end still is from that state, are measured from (settling.hpp).
+  // Absent: a dynamic scene.
+  std::optional<SettlingBody> settling;
 };
 
 struct MmsProblem {

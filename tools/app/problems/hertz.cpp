@@ -183,6 +183,7 @@ ProblemSetup setup(const Config& c) {
   const double density = c.real("density");
   const double omega = 0.5 * std::numbers::pi * std::sqrt(lame.mu / density) / D;
   const QuasiStatic qs = quasi_static_from(c, omega);
+  s.settling = SettlingBody{omega, lame.mu, qs.damping};
   s.smooth_until = qs.ramp_time;
   // The plate starts at rest; the exact state is not a motion of the plate.
   s.solution = mms::make_solution(analytic::RampedHomogeneousMotion{Mat2::Zero(), qs.ramp_time, D}, s.material,

@@ -64,6 +64,7 @@ ProblemSetup setup(const Config& c) {
   // Lowest mode, support to free end: omega = pi c / (2 L).
   const double omega = 0.5 * std::numbers::pi * std::sqrt(lame.plane_strain_modulus() / density) / L;
   const QuasiStatic qs = quasi_static_from(c, omega);
+  s.settling = SettlingBody{omega, lame.mu, qs.damping};
   s.smooth_until = qs.ramp_time;
 
   Mat2 D = Mat2::Zero();

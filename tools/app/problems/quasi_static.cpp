@@ -21,6 +21,11 @@ std::vector<KeySpec> static_scene_keys(std::vector<KeySpec> k, const std::vector
        -inf, inf, false, false, {"explicit", "implicit"}},
       {"load_steps", KeyKind::integer, std::int64_t(4),
        "implicit: equal steps over the ramp (then steps of that length at full load to the end time)", 1, 100000},
+      {"newton_tolerance", KeyKind::real, 1e-8,
+       "implicit: a load step's Newton iteration stops at max |R| / (2 mu h) below this (R the nodal force "
+       "residual: about the displacement error over h); the results' settling_displacement says how far from "
+       "equilibrium that leaves the end",
+       0.0, 1e-2, true},
       {"ramp_periods", KeyKind::real, 4.0,
        "the load rises over this many periods of the body's lowest mode, (1 - cos(pi t / T)) / 2, then holds", 0.0,
        inf, true},

@@ -55,6 +55,7 @@ ProblemSetup setup(const Config& c) {
   const double gamma = shift / H, tau = solid.shear_stress(gamma);
   const double omega = std::numbers::pi * std::sqrt(lame.mu / density) / H;
   const QuasiStatic qs = quasi_static_from(c, omega);
+  s.settling = SettlingBody{omega, lame.mu, qs.damping};
   s.smooth_until = qs.ramp_time;
 
   Mat2 D = Mat2::Zero();

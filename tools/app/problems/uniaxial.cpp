@@ -68,6 +68,7 @@ ProblemSetup setup(const Config& c) {
   // Lowest axial mode between support and grip: omega = pi c / L.
   const double omega = std::numbers::pi * std::sqrt(lame.plane_strain_modulus() / density) / L;
   const QuasiStatic qs = quasi_static_from(c, omega);
+  s.settling = SettlingBody{omega, lame.mu, qs.damping};
   s.smooth_until = qs.ramp_time;
 
   Mat2 D = Mat2::Zero();
