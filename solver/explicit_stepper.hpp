@@ -24,8 +24,8 @@ struct ParticleFault {
 };
 
 // How far a body settling to a static state still is from it: the RMS over
-// the body of the displacement still to come [m], and of the change of the
-// deformation gradient F still to come (Frobenius; dimensionless).
+// the body of the displacement still to come [m], and of the small strain
+// that motion makes (the symmetric part of F's change; dimensionless).
 struct Settling {
   double displacement = std::numeric_limits<double>::quiet_NaN();
   double strain = std::numeric_limits<double>::quiet_NaN();

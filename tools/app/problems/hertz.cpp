@@ -182,9 +182,7 @@ ProblemSetup setup(const Config& c) {
   const double E_star = analytic::contact_modulus_rigid(lame.youngs_modulus(), lame.poisson_ratio());
   const double density = c.real("density");
   const double omega = 0.5 * std::numbers::pi * std::sqrt(lame.mu / density) / D;
-  const QuasiStatic qs = quasi_static_from(c, omega);
-  s.settling = SettlingBody{omega, lame.mu, qs.damping};
-  s.smooth_until = qs.ramp_time;
+  const QuasiStatic qs = quasi_static_from(c, omega, lame.mu, s);
   // The plate starts at rest; the exact state is not a motion of the plate.
   s.solution = mms::make_solution(analytic::RampedHomogeneousMotion{Mat2::Zero(), qs.ramp_time, D}, s.material,
                                   density, s.geometry);

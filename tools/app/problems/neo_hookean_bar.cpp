@@ -63,9 +63,7 @@ ProblemSetup setup(const Config& c) {
   const double density = c.real("density");
   // Lowest mode, support to free end: omega = pi c / (2 L).
   const double omega = 0.5 * std::numbers::pi * std::sqrt(lame.plane_strain_modulus() / density) / L;
-  const QuasiStatic qs = quasi_static_from(c, omega);
-  s.settling = SettlingBody{omega, lame.mu, qs.damping};
-  s.smooth_until = qs.ramp_time;
+  const QuasiStatic qs = quasi_static_from(c, omega, lame.mu, s);
 
   Mat2 D = Mat2::Zero();
   D(0, 0) = l1 - 1.0;

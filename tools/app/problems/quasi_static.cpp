@@ -44,14 +44,17 @@ void add_bar_probes(ProblemSetup& s, double L, double half, int points) {
   s.points.push_back({"point_top_middle", ProbeQuantity::displacement_y, Vec2(0.5 * L, half)});
 }
 
-QuasiStatic quasi_static_from(const Config& c, double omega) {
+QuasiStatic quasi_static_from(const Config& c, double omega, double shear_modulus, ProblemSetup& s) {
   const double period = 2.0 * std::numbers::pi / omega;
   const double ramp_time = c.real("ramp_periods") * period;
   if (c.real("end_time") < 1.5 * ramp_time)
     c.reject("end_time", fmt::format("leaves no time to settle: the ramp lasts {:.6g} s ({} periods of {:.6g} s); "
                                      "use at least {:.6g} s",
                                      ramp_time, c.real("ramp_periods"), period, 1.5 * ramp_time));
-  return {ramp_time, c.real("damping_ratio") * 2.0 * omega};
+  const QuasiStatic qs{ramp_time, c.real("damping_ratio") * 2.0 * omega};
+  s.smooth_until = qs.ramp_time;
+  s.settling = SettlingBody{omega, shear_modulus, qs.damping};
+  return qs;
 }
 
 namespace {

@@ -54,9 +54,7 @@ ProblemSetup setup(const Config& c) {
   const double density = c.real("density");
   const double gamma = shift / H, tau = solid.shear_stress(gamma);
   const double omega = std::numbers::pi * std::sqrt(lame.mu / density) / H;
-  const QuasiStatic qs = quasi_static_from(c, omega);
-  s.settling = SettlingBody{omega, lame.mu, qs.damping};
-  s.smooth_until = qs.ramp_time;
+  const QuasiStatic qs = quasi_static_from(c, omega, lame.mu, s);
 
   Mat2 D = Mat2::Zero();
   D(0, 1) = gamma;

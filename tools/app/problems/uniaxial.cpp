@@ -67,9 +67,7 @@ ProblemSetup setup(const Config& c) {
   const double sigma = bar.stress_plane_strain(eps);
   // Lowest axial mode between support and grip: omega = pi c / L.
   const double omega = std::numbers::pi * std::sqrt(lame.plane_strain_modulus() / density) / L;
-  const QuasiStatic qs = quasi_static_from(c, omega);
-  s.settling = SettlingBody{omega, lame.mu, qs.damping};
-  s.smooth_until = qs.ramp_time;
+  const QuasiStatic qs = quasi_static_from(c, omega, lame.mu, s);
 
   Mat2 D = Mat2::Zero();
   D(0, 0) = eps;
