@@ -979,7 +979,10 @@ DEFINITIONS = (
     "a 95% Student-t interval (none with two levels). Class: round-off when some level's error is positive and at "
     f"most its round-off floor, ({orders.ROUNDOFF_ULPS} + steps) ulps of the numbers the error is a difference of "
     "(the body's coordinates for a displacement, not the displacement; 1 for a relative error): rounding alone "
-    "can explain it, and no order is given (the error over the exact signal it measures is shown); stalled when "
+    "can explain it, and no order is given (the error over the exact signal it measures is shown); settling when "
+    "the run settles to a static state and some level's error is positive and at most what its stopping short of "
+    "that state could leave in the norm (the results file's /settling, reports/README.md): no order is given "
+    "either; stalled when "
     f"the finest pairwise order is below {orders.STALLED_BELOW}; non-asymptotic when the pairwise orders span more "
     f"than {orders.ASYMPTOTIC_SPREAD}; unchecked with one pair; asymptotic otherwise. A level is usable when its "
     "case wrote the norm at that time (a failed run keeps the outputs it reached).")
