@@ -50,6 +50,7 @@ const CaughtByTheQuickGate kQuickGateCatalogue[] = {
     {"pic-velocity", "^(axis-aligned|rz-cylinder)-", {8, 9, 10, 11}},
     {"kirchhoff-stress", "^(axis-aligned|rz-cylinder)-", {8, 9, 10, 11}},
     {"swapped-walls", "^(axis-aligned|rz-cylinder)-", {8, 9, 10, 11}},
+    {"cpdi-weight", "^uniaxial-cpdi-", {12}},
 };
 
 std::string name_of(const ::testing::TestParamInfo<CaughtByTheQuickGate>& info) {
@@ -95,11 +96,12 @@ TEST_P(QuickGate, CatchesTheFault) {
 // the point a particle's weights stand for by a tenth of its domain's
 // half-vector r_1: an error of first order in h whose constant is small, so
 // the quick suite's orders on 8-128 cells still read second order under it
-// (measured: ring L1 at 128 cells 2.229e-3 against 2.200e-3 without). What
-// catches it is the check of linear completeness the transfers rely on
-// (test_velocity_transfer.cpp: affine motion goes to the grid and back
-// without loss): sum_g S_gp x_g = x_p. Here that check, on a sheared CPDI
-// domain, holds for the shape as built and fails under the fault.
+// (measured: ring L1 at 128 cells 2.229e-3 against 2.200e-3 without). It
+// breaks the linear completeness the transfers rely on (test_velocity_
+// transfer.cpp: affine motion goes to the grid and back without loss),
+// sum_g S_gp x_g = x_p: the quick suite's homogeneous bar (expectation 12)
+// catches it in the particles' positions, and here the check itself, on a
+// sheared CPDI domain, holds for the shape as built and fails under the fault.
 TEST(FaultCatalogue, CpdiWeightBreaksLinearCompleteness) {
   mpmvv::GridGeometry grid;
   grid.origin = mpmvv::Vec2(-1.0, -1.0);
