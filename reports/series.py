@@ -187,19 +187,23 @@ class RoundOff:
     floor: float          # orders.roundoff_floor(the case's steps, M)
     settling: float = None
 
+    def _relative(self, value):
+        # NaN where the signal is not known (a level checked for settling alone).
+        if value is None or not math.isfinite(self.signal):
+            return float("nan")
+        return value / self.signal if self.signal > 0 else float("inf")
+
     @property
     def relative_error(self):
-        return self.level.error / self.signal if self.signal > 0 else float("inf")
+        return self._relative(self.level.error)
 
     @property
     def relative_floor(self):
-        return self.floor / self.signal if self.signal > 0 else float("inf")
+        return self._relative(self.floor)
 
     @property
     def relative_settling(self):
-        if self.settling is None:
-            return float("nan")
-        return self.settling / self.signal if self.signal > 0 else float("inf")
+        return self._relative(self.settling)
 
     @property
     def at_roundoff(self):

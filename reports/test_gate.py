@@ -5,6 +5,7 @@ when its fitted order is in band, its error constant is under the limit and
 (must_complete) every case completed; exit 0 when all hold, 1 when one falls
 short, 2 with one line for a directory that cannot be read."""
 import json
+import math
 from dataclasses import replace
 
 import h5py
@@ -16,7 +17,7 @@ import report
 from conftest import (RING_TIMES, ROUNDOFF_SUITE, SYNTHETIC_SUITE, roundoff_cases, synthetic_ring_cases,
                       write_suite_directory)
 from results import error_scale, read_suite, settling_scale
-from series import error_floor_kind, refinement_series, series_levels
+from series import Level, RoundOff, error_floor_kind, refinement_series, series_levels
 
 
 def run_gate(directory, capsys):
@@ -520,6 +521,11 @@ def test_an_order_at_the_settling_level_fails_and_says_so(tmp_path, capsys):
     assert settling_scale(case, "particle_L2", 1.0) == pytest.approx(5e-14)
     assert settling_scale(case, "particle_L2", 0.5) is None
     assert settling_scale(case, "particle_pressure_L2", 1.0) is None
+    # A level checked for settling alone (no known exact signal) is judged,
+    # and its relative numbers are NaN, not infinite.
+    alone = RoundOff(Level(case, 128, case.h, 2.5e-14, ""), float("nan"), 0.0, 5e-14)
+    assert alone.floor_kind == "settling"
+    assert all(math.isnan(v) for v in (alone.relative_error, alone.relative_floor, alone.relative_settling))
 
 
 def test_a_small_strain_is_rounded_to_ulps_of_one(tmp_path):
