@@ -24,9 +24,8 @@ Classification of a range (the rule, applied in this order):
 * ``settling``: the run settles to a static state (dynamic relaxation, implicit
   load steps), and the error of some usable level is positive and at most what
   the run's distance from that state at the end could leave in the norm
-  (results.py: settling_scale, from the results file's settling_displacement
-  and settling_strain): the solver's stopping point can explain it, and no
-  order is given;
+  (results.py: settling_scale, from the results file's /settling group): the
+  solver's stopping point can explain it, and no order is given;
 * ``stalled``: the last pairwise order (between the two finest levels) is below
   STALLED_BELOW = 0.5: the error no longer falls with h;
 * ``non-asymptotic``: the pairwise orders span more than ASYMPTOTIC_SPREAD = 0.5

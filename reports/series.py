@@ -249,8 +249,7 @@ def pair_order_cell(cases, norm, time, errors, sizes, width=9):
     """A table cell with the observed order between two levels (coarse, fine: their
     cases, errors of `norm` at output time `time`, and sizes h), or what explains
     either error in its place ("round-off", "settling": RoundOff.floor_kind)."""
-    kinds = [error_floor_kind(case, norm, time, error) for case, error in zip(cases, errors)]
-    kind = ROUNDOFF if ROUNDOFF in kinds else SETTLING if SETTLING in kinds else None
+    kind = floor_kind([_single_check(case, norm, time, error) for case, error in zip(cases, errors)])
     if kind:
         return f"{kind:>{width}}"
     return f"{pairwise_orders(list(sizes), list(errors))[0]:>{width}.2f}"
@@ -260,13 +259,14 @@ def error_floor_kind(case, norm, time, error):
     """What may explain `error`, the case's `norm` at output time `time`, other
     than the method (RoundOff.floor_kind), for tables that compare single results
     files."""
-    [check] = roundoff_checks([Level(case, None, case.h, error, "")], norm, time)
+    check = _single_check(case, norm, time, error)
     return None if check is None else check.floor_kind
 
 
-def at_floor(checks):
-    """The checks whose level's error is at round-off or at the settling level."""
-    return [c for c in checks if c is not None and c.floor_kind]
+def _single_check(case, norm, time, error):
+    """The RoundOff of one results file's `error` (roundoff_checks), or None."""
+    [check] = roundoff_checks([Level(case, None, case.h, error, "")], norm, time)
+    return check
 
 
 def floor_kind(checks):
@@ -293,4 +293,4 @@ def floor_text(refine, checks):
                 f"round-off floor {largest.relative_floor:.2g})")
     ratio = max(c.settling / c.level.error for c in at)
     return (f"the settling level at {refine}={levels} (the run's distance from its static state at the end "
-            f"could leave up to {ratio:.2g} times the error: results settling_displacement, settling_strain)")
+            f"could leave up to {ratio:.2g} times the error: the results file's /settling)")
