@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstddef>
+#include <utility>
 #include <vector>
 
 #ifdef _OPENMP
@@ -32,6 +33,27 @@ inline void set_threads(int n) {
 #else
   (void)n;
 #endif
+}
+
+// The iterations [first, last) of a loop over [begin, end) that `omp for
+// schedule(static)` gives the calling thread: contiguous blocks in thread
+// order, the first (end - begin) % T threads one iteration longer (libgomp's
+// split). A thread that walks its block in its own steps (by lanes, say) then
+// visits the same particles in the same order as the `omp for` would.
+inline std::pair<std::size_t, std::size_t> static_block(std::size_t begin, std::size_t end) {
+#ifdef _OPENMP
+  const std::size_t threads = std::size_t(omp_get_num_threads()), t = std::size_t(omp_get_thread_num());
+#else
+  const std::size_t threads = 1, t = 0;
+#endif
+  const std::size_t n = end > begin ? end - begin : 0;
+  std::size_t q = n / threads, r = n % threads;
+  if (t < r) {
+    r = 0;
+    ++q;
+  }
+  const std::size_t first = begin + q * t + r;
+  return {first, first + q};
 }
 
 // Called by every thread of a parallel region once each thread has filled its

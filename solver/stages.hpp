@@ -22,6 +22,7 @@
 #include "material/stress.hpp"
 #include "parallel.hpp"
 #include "particles.hpp"
+#include "shape/cpdi_lanes.hpp"
 #include "shape/linear.hpp"
 #include "shape/stencil.hpp"
 
@@ -54,6 +55,13 @@ struct ScatterBuffers {
     per_thread.assign(std::size_t(threads), std::vector<NodeSums>(nodes));
   }
 };
+
+// True for a shape that evaluates its stencils by lanes (cpdi_lanes.hpp).
+template <class Shape>
+constexpr bool evaluates_lanes() {
+  if constexpr (requires { Shape::lanes; }) return Shape::lanes;
+  return false;
+}
 
 // A range of particles [first, last): one body of a scene with several, which
 // keep their particles contiguous. The whole set by default.
@@ -91,18 +99,9 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
   {
     NodeSums* sums = buffers.per_thread[std::size_t(thread_id())].data();
     std::fill(sums, sums + nodes, NodeSums{0.0, 0.0, 0.0, 0.0, 0.0});
-    Stencil<Shape::stencil_size> s;
     [[maybe_unused]] double max_speed = 0.0;
     [[maybe_unused]] std::size_t first_unhealthy = P.size();
-#pragma omp for schedule(static)
-    for (std::size_t p = range.first; p < n; ++p) {
-      if constexpr (scanning) {
-        if (!scan->healthy(p)) {
-          first_unhealthy = std::min(first_unhealthy, p);
-          continue;
-        }
-      }
-      shape.evaluate(p, s);
+    auto map = [&](std::size_t p, const Stencil<Shape::stencil_size>& s) {
       if constexpr (scanning) max_speed = std::max(max_speed, scan->speed(p, s, max_speed));
       const double m = P.mass[p];
       Vec2 momentum = Vec2::Zero(), body = Vec2::Zero();
@@ -133,6 +132,39 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
           node.force_y += f.y();
         }
       }
+    };
+    // A particle the scan finds unhealthy is reported and skipped.
+    auto usable = [&](std::size_t p) {
+      if constexpr (scanning) {
+        if (!scan->healthy(p)) {
+          first_unhealthy = std::min(first_unhealthy, p);
+          return false;
+        }
+      }
+      return true;
+    };
+    if constexpr (evaluates_lanes<Shape>()) {
+      // Eight stencils at a time (cpdi_lanes.hpp), over the particles the
+      // static schedule gives this thread, in the same order.
+      const auto [first, last] = static_block(range.first, n);
+      Stencil<Shape::stencil_size> s[kCpdiLanes];
+      for (std::size_t p0 = first; p0 < last; p0 += kCpdiLanes) {
+        const int count = int(std::min<std::size_t>(kCpdiLanes, last - p0));
+        bool use[kCpdiLanes];
+        for (int l = 0; l < count; ++l) use[l] = usable(p0 + std::size_t(l));
+        shape.evaluate_lanes(p0, count, use, s);
+        for (int l = 0; l < count; ++l)
+          if (use[l]) map(p0 + std::size_t(l), s[l]);
+      }
+#pragma omp barrier
+    } else {
+      Stencil<Shape::stencil_size> s;
+#pragma omp for schedule(static)
+      for (std::size_t p = range.first; p < n; ++p) {
+        if (!usable(p)) continue;
+        shape.evaluate(p, s);
+        map(p, s);
+      }
     }
     if constexpr (scanning) {
       // A largest and a lowest: the same whatever order the threads come in.
@@ -142,7 +174,7 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
         scan->result.first_unhealthy = std::min(scan->result.first_unhealthy, first_unhealthy);
       }
     }
-    // The implicit barrier of the particles' `omp for` above: all buffers are complete.
+    // The barrier after the particles above: all buffers are complete.
 #pragma omp for schedule(static)
     for (std::size_t i = 0; i < nodes; ++i) {
       NodeSums total = buffers.per_thread[0][i];
@@ -265,10 +297,7 @@ void grid_to_particles(const Shape& shape, const GridFields& g, Particles& P, do
   const std::size_t n = range.end(P);
 #pragma omp parallel
   {
-    Stencil<Shape::stencil_size> s;
-#pragma omp for schedule(static)
-    for (std::size_t p = range.first; p < n; ++p) {
-      shape.evaluate(p, s);
+    auto update = [&](std::size_t p, const Stencil<Shape::stencil_size>& s) {
       Vec2 acceleration = Vec2::Zero(), velocity = Vec2::Zero();
       Mat2 L = Mat2::Zero();  // the velocity gradient, for F and for APIC's C_p
       double hoop_rate = 0.0;
@@ -295,6 +324,23 @@ void grid_to_particles(const Shape& shape, const GridFields& g, Particles& P, do
         P.velocity[p] += kick * acceleration;
       }
       if constexpr (with_position) position_out[p] = P.position[p] + dt * velocity;
+    };
+    if constexpr (evaluates_lanes<Shape>()) {
+      const auto [first, last] = static_block(range.first, n);
+      Stencil<Shape::stencil_size> s[kCpdiLanes];
+      const bool use[kCpdiLanes] = {true, true, true, true, true, true, true, true};
+      for (std::size_t p0 = first; p0 < last; p0 += kCpdiLanes) {
+        const int count = int(std::min<std::size_t>(kCpdiLanes, last - p0));
+        shape.evaluate_lanes(p0, count, use, s);
+        for (int l = 0; l < count; ++l) update(p0 + std::size_t(l), s[l]);
+      }
+    } else {
+      Stencil<Shape::stencil_size> s;
+#pragma omp for schedule(static)
+      for (std::size_t p = range.first; p < n; ++p) {
+        shape.evaluate(p, s);
+        update(p, s);
+      }
     }
   }
 }
@@ -578,6 +624,22 @@ double entry_gradient_sum(const Stencil<N>& s) {
   return sum;
 }
 
+// An upper bound of the same without a square root, entry by entry
+// |G| <= max(|G_x|, |G_y|) + (sqrt 2 - 1) min(|G_x|, |G_y|) (the chord of the
+// convex sqrt(1 + t^2) over t in [0, 1], equal at its ends): the scan runs it
+// for every particle every step, where nine square roots in a row cost more
+// than the rest of the particle's test.
+template <int N>
+double entry_gradient_sum_bound(const Stencil<N>& s) {
+  constexpr double kOctagon = 0.41421356237309515;  // sqrt 2 - 1, rounded up
+  double sum = 0.0;
+  for (int k = 0; k < s.count; ++k) {
+    const double x = std::abs(s.gradient[k].x()), y = std::abs(s.gradient[k].y());
+    sum += std::max(x, y) + kOctagon * std::min(x, y);
+  }
+  return sum;
+}
+
 // The same for particle p's stencil, evaluated here.
 template <class Shape>
 double gradient_sum(const Shape& shape, std::size_t p) {
@@ -647,11 +709,16 @@ double signal_speed(const Shape& shape, const Material& material, const Particle
   const double F33 = out_of_plane_stretch<Shape::geometry>(P, p);
   const double v = P.velocity[p].norm();
   // With the stencil at hand the bound of k_p is its sum of |G| over entries,
-  // which is k_p's own sum where no node repeats (a stencil that is not full).
+  // which is k_p's own sum where no node repeats (a stencil that is not full);
+  // the test that rules a particle out reads a bound of that sum without
+  // square roots (entry_gradient_sum_bound) and the sum itself only if it
+  // has to.
   [[maybe_unused]] double most = 1.0;
+  [[maybe_unused]] bool most_exact = true;
   if constexpr (Shape::gradients_beyond_grid_basis) {
-    const double bound = stencil ? entry_gradient_sum(*stencil) : shape.gradient_sum_bound(p);
+    const double bound = stencil ? entry_gradient_sum_bound(*stencil) : shape.gradient_sum_bound(p);
     most = std::max(1.0, h * bound / kGridBasisGradientBound);
+    most_exact = !stencil || most == 1.0;  // a bound under 1 leaves k_p's own bound at 1 too
   }
   if constexpr (!requires { shape.cell_stretch(p); } &&
                 requires { material.wave_modulus_bound(P.deformation_gradient[p], F33, P.stress[p]); }) {
@@ -662,6 +729,8 @@ double signal_speed(const Shape& shape, const Material& material, const Particle
       if (modulus <= density * room * room) return 0.0;
     }
   }
+  if constexpr (Shape::gradients_beyond_grid_basis)
+    if (!most_exact) most = std::max(1.0, h * entry_gradient_sum(*stencil) / kGridBasisGradientBound);
   const double c = std::sqrt(material.wave_modulus(P.deformation_gradient[p], F33, P.stress[p]) / density);
   double speed = c;
   // The total Lagrangian formulation: a wave crosses the current image of a

@@ -28,10 +28,12 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 
 #include "../domain_corners.hpp"
 #include "../particles.hpp"
+#include "cpdi_lanes.hpp"
 #include "linear.hpp"
 #include "stencil.hpp"
 
@@ -109,26 +111,31 @@ struct CpdiShapeT {
 
   // Corner domains: the corner factors of S_gp and G_gp (above), given the
   // quadrilateral's linear part s = domain(p), which every caller has formed.
-  void quadrilateral_factors(std::size_t p, const Mat2& s, double* weight, Vec2* gradient) const {
+  void quadrilateral_factors(std::size_t p, const Mat2& s, double* weight, double* gradient_x,
+                             double* gradient_y) const {
     const Vec2* x = corners + 4 * p;
-    const Vec2 a3 = 0.25 * (x[0] - x[1] + x[2] - x[3]);
+    const double a3x = 0.25 * (x[0].x() - x[1].x() + x[2].x() - x[3].x());
+    const double a3y = 0.25 * (x[0].y() - x[1].y() + x[2].y() - x[3].y());
     const double J0 = determinant(s);
-    const double J1 = s(0, 0) * a3.y() - s(1, 0) * a3.x();
-    const double J2 = a3.x() * s(1, 1) - a3.y() * s(0, 1);
+    const double J1 = s(0, 0) * a3y - s(1, 0) * a3x;
+    const double J2 = a3x * s(1, 1) - a3y * s(0, 1);
     const double inv = gradient_scale / (8.0 * J0);
     for (int c = 0; c < 4; ++c) {
       weight[c] = 0.25 * (1.0 + (J1 * corner_xi[c] + J2 * corner_eta[c]) / (3.0 * J0));
-      const Vec2 d = x[(c + 1) % 4] - x[(c + 3) % 4];
-      gradient[c] = inv * Vec2(d.y(), -d.x());
+      const Vec2& next = x[(c + 1) % 4];
+      const Vec2& previous = x[(c + 3) % 4];
+      gradient_x[c] = inv * (next.y() - previous.y());
+      gradient_y[c] = inv * -(next.x() - previous.x());
     }
   }
 
   // The corner factors of G_gp = sum_c S_g(x_c) g_c (above, with the r-z
   // weights), for the corners in the order of corner_xi, corner_eta.
-  void corner_gradients(std::size_t p, const Mat2& s, Vec2* g) const {
+  // Scalars, x and y apart (evaluate, below, says why).
+  void corner_gradients(std::size_t p, const Mat2& s, double* gx, double* gy) const {
     if constexpr (Corners) {
       double w[4];
-      quadrilateral_factors(p, s, w, g);
+      quadrilateral_factors(p, s, w, gx, gy);
       return;
     }
     // s^-T = [[s11, -s10], [-s01, s00]] / det s.
@@ -146,7 +153,8 @@ struct CpdiShapeT {
         gxi *= 1.0 + weight_b * eta;
         geta *= 1.0 + weight_a * xi;
       }
-      g[c] = inv_det * Vec2(s(1, 1) * gxi - s(1, 0) * geta, s(0, 0) * geta - s(0, 1) * gxi);
+      gx[c] = inv_det * (s(1, 1) * gxi - s(1, 0) * geta);
+      gy[c] = inv_det * (s(0, 0) * geta - s(0, 1) * gxi);
     }
   }
 
@@ -158,8 +166,8 @@ struct CpdiShapeT {
   // centre (x_p, or a_0 for corner domains).
   double gradient_sum_bound(std::size_t p) const {
     const Mat2 s = domain(p);
-    Vec2 g[4];
-    corner_gradients(p, s, g);
+    double gx[4], gy[4];
+    corner_gradients(p, s, gx, gy);
     Vec2 centre = Vec2::Zero();
     if constexpr (Corners) centre = 0.25 * (corners[4 * p] + corners[4 * p + 1] + corners[4 * p + 2] + corners[4 * p + 3]);
     double bound = 0.0;
@@ -167,7 +175,7 @@ struct CpdiShapeT {
       Vec2 offset;
       if constexpr (Corners) offset = corners[4 * p + c] - centre;
       else offset = corner_xi[c] * s.col(0) + corner_eta[c] * s.col(1);
-      bound += g[c].norm() * std::min(2.0, 2.0 * offset.cwiseAbs().sum() / grid->h);
+      bound += std::sqrt(gx[c] * gx[c] + gy[c] * gy[c]) * std::min(2.0, 2.0 * offset.cwiseAbs().sum() / grid->h);
     }
     return bound;
   }
@@ -178,6 +186,11 @@ struct CpdiShapeT {
   // which is all of them until shear stretches one) reaches at most the 3 x 3
   // nodes from its lowest corner cell: each is summed and listed once (4, 6 or
   // 9 entries instead of 16), which the transfers then visit once.
+  //
+  // Written on scalars rather than on 2-vectors: a vector assembled from two
+  // scalars and read back whole stalls the load on its two halves' stores, and
+  // those stalls were a third of this function's time. Every sum and product
+  // is the one of the formulas above, in the same order.
   void evaluate(std::size_t p, Stencil<stencil_size>& st) const {
     const GridGeometry& g = *grid;
     const Mat2 s = domain(p);
@@ -189,21 +202,32 @@ struct CpdiShapeT {
     }
     const double hoop_factor = 0.75 * weight_r;  // <S/r> = (1 / (4 r_p)) sum_c S_g(x_c)
     int cell_i[4], cell_j[4];
-    double fx[4], fy[4], corner_weight[4];
-    Vec2 corner_gradient[4];
-    if constexpr (Corners) quadrilateral_factors(p, s, corner_weight, corner_gradient);
-    else corner_gradients(p, s, corner_gradient);
+    double fx[4], fy[4], corner_weight[4], grad_x[4], grad_y[4];
+    if constexpr (Corners) quadrilateral_factors(p, s, corner_weight, grad_x, grad_y);
+    else corner_gradients(p, s, grad_x, grad_y);
+    const double px = position[p].x(), py = position[p].y();
+    const double s00 = s(0, 0), s01 = s(0, 1), s10 = s(1, 0), s11 = s(1, 1);
+    const double ox = g.origin.x(), oy = g.origin.y(), h = g.h;
     for (int c = 0; c < 4; ++c) {
       if constexpr (!Corners) {
         double cw = 0.25 * (1.0 + weight_skew * corner_xi[c]);
         if constexpr (G == Geometry::axisymmetric) cw *= 1.0 + weight_a * corner_xi[c] + weight_b * corner_eta[c];
         corner_weight[c] = cw;
       }
-      const Vec2 x = grid_coordinate(g, corner(p, s, c));
-      cell_i[c] = cell_index(x.x(), g.cells_x);
-      cell_j[c] = cell_index(x.y(), g.cells_y);
-      fx[c] = x.x() - cell_i[c];
-      fy[c] = x.y() - cell_j[c];
+      double x, y;  // corner(p, s, c)
+      if constexpr (Corners) {
+        x = corners[4 * p + c].x();
+        y = corners[4 * p + c].y();
+      } else {
+        x = px + corner_xi[c] * s00 + corner_eta[c] * s01;
+        y = py + corner_xi[c] * s10 + corner_eta[c] * s11;
+      }
+      x = (x - ox) / h;  // grid_coordinate
+      y = (y - oy) / h;
+      cell_i[c] = cell_index(x, g.cells_x);
+      cell_j[c] = cell_index(y, g.cells_y);
+      fx[c] = x - cell_i[c];
+      fy[c] = y - cell_j[c];
     }
     const int i0 = std::min(std::min(cell_i[0], cell_i[1]), std::min(cell_i[2], cell_i[3]));
     const int j0 = std::min(std::min(cell_j[0], cell_j[1]), std::min(cell_j[2], cell_j[3]));
@@ -227,7 +251,7 @@ struct CpdiShapeT {
         for (int k = 0; k < 4; ++k) {
           st.node[4 * c + k] = nodes[k];
           st.weight[4 * c + k] = corner_weight[c] * b[k];
-          st.gradient[4 * c + k] = corner_gradient[c] * b[k];
+          st.gradient[4 * c + k] = Vec2(grad_x[c] * b[k], grad_y[c] * b[k]);
           if constexpr (G == Geometry::axisymmetric) st.hoop[4 * c + k] = hoop_factor * b[k];
         }
       }
@@ -235,9 +259,7 @@ struct CpdiShapeT {
       return;
     }
     // Node (i0 + a, j0 + b) sums into slot a + 3 b.
-    double w[9] = {}, hoop[9] = {};
-    Vec2 grad[9];
-    for (Vec2& v : grad) v.setZero();
+    double w[9] = {}, hoop[9] = {}, gsx[9] = {}, gsy[9] = {};
     for (int c = 0; c < 4; ++c) {
       double b[4];
       bilinear(c, b);
@@ -245,7 +267,8 @@ struct CpdiShapeT {
       const int slot[4] = {first, first + 1, first + 3, first + 4};
       for (int k = 0; k < 4; ++k) {
         w[slot[k]] += corner_weight[c] * b[k];
-        grad[slot[k]] += corner_gradient[c] * b[k];
+        gsx[slot[k]] += grad_x[c] * b[k];
+        gsy[slot[k]] += grad_y[c] * b[k];
         if constexpr (G == Geometry::axisymmetric) hoop[slot[k]] += hoop_factor * b[k];
       }
     }
@@ -255,10 +278,59 @@ struct CpdiShapeT {
         const int slot = a + 3 * b;
         st.node[n] = g.node(i0 + a, j0 + b);
         st.weight[n] = w[slot];
-        st.gradient[n] = grad[slot];
+        st.gradient[n] = Vec2(gsx[slot], gsy[slot]);
         if constexpr (G == Geometry::axisymmetric) st.hoop[n] = hoop[slot];
       }
     st.count = n;
+  }
+
+  // Plane-strain parallelogram domains are evaluated eight particles at a
+  // time by the lane kernel (cpdi_lanes.hpp), to the same bits as evaluate.
+  static constexpr bool lanes = G == Geometry::plane_strain && !Corners;
+
+  // The stencils of particles first, ..., first + count - 1 (count at most
+  // kCpdiLanes) into st[0], ..., st[count - 1], as evaluate gives them; a
+  // particle whose `use` is false (one the scan found unhealthy, whose
+  // domain may leave the grid) is read but not listed. `build` picks a build
+  // of the kernel (tests); by default the widest the CPU has.
+  void evaluate_lanes(std::size_t first, int count, const bool* use, Stencil<stencil_size>* st,
+                      const LaneBuild* build = nullptr) const
+    requires lanes
+  {
+    const GridGeometry& g = *grid;
+    CpdiLaneInput in;
+    for (int l = 0; l < kCpdiLanes; ++l) {
+      const std::size_t p = first + std::size_t(l < count ? l : 0);  // spare lanes repeat the first
+      const Mat2 s = domain(p);
+      in.x[l] = position[p].x();
+      in.y[l] = position[p].y();
+      in.s00[l] = s(0, 0);
+      in.s01[l] = s(0, 1);
+      in.s10[l] = s(1, 0);
+      in.s11[l] = s(1, 1);
+    }
+    CpdiLaneStencils out;
+    const CpdiLaneGrid lane_grid{g.origin.x(), g.origin.y(), g.h, g.cells_x, g.cells_y, gradient_scale, weight_skew};
+    if (build) cpdi_lane_stencils(*build, lane_grid, in, out);
+    else cpdi_lane_stencils(lane_grid, in, out);
+    for (int l = 0; l < count; ++l) {
+      if (!use[l]) continue;
+      const int span_i = out.span_i[l], span_j = out.span_j[l];
+      if (span_i > 1 || span_j > 1) {
+        evaluate(first + std::size_t(l), st[l]);
+        continue;
+      }
+      // The nodes the corners reach, as evaluate lists them.
+      int n = 0;
+      for (int b = 0; b <= span_j + 1; ++b)
+        for (int a = 0; a <= span_i + 1; ++a, ++n) {
+          const int slot = a + 3 * b;
+          st[l].node[n] = g.node(out.i0[l] + a, out.j0[l] + b);
+          st[l].weight[n] = out.weight[slot][l];
+          st[l].gradient[n] = Vec2(out.gradient_x[slot][l], out.gradient_y[slot][l]);
+        }
+      st[l].count = n;
+    }
   }
 
   // A corner domain turned over, 4 det [a_1 a_2] <= 0 (monitors.hpp:

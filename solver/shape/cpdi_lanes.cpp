@@ -1,0 +1,203 @@
+// The lane kernel of cpdi_lanes.hpp, on GCC's vector types: one variable holds
+// a quantity of W lanes, W the width of the build's registers (8 doubles for
+// AVX-512, 4 for AVX2, 2 for SSE2), and the eight lanes are taken W at a time
+// so that the kernel's values stay in registers. Each line is the scalar
+// line of CpdiShapeT::evaluate it repeats.
+#include "cpdi_lanes.hpp"
+
+#include <cstring>
+
+#include "../domain_corners.hpp"  // kCornerXi, kCornerEta
+
+namespace mpmvv {
+
+namespace {
+
+// Inlined into each build of the kernel, so that no vector crosses a call
+// (the warning is about how one would be passed if it did).
+#define MPMVV_LANE_INLINE inline __attribute__((always_inline))
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+// W lanes of doubles, of their comparisons and of ints (one specialization
+// per width: GCC keeps a vector size only where it is not a template's).
+template <int W>
+struct Width;
+template <>
+struct Width<8> {
+  typedef double Lanes __attribute__((vector_size(64)));
+  typedef long long Mask __attribute__((vector_size(64)));
+  typedef int Ints __attribute__((vector_size(32)));
+};
+template <>
+struct Width<4> {
+  typedef double Lanes __attribute__((vector_size(32)));
+  typedef long long Mask __attribute__((vector_size(32)));
+  typedef int Ints __attribute__((vector_size(16)));
+};
+template <>
+struct Width<2> {
+  typedef double Lanes __attribute__((vector_size(16)));
+  typedef long long Mask __attribute__((vector_size(16)));
+  typedef int Ints __attribute__((vector_size(8)));
+};
+
+template <class V>
+MPMVV_LANE_INLINE V load(const double* a) {
+  V v;
+  std::memcpy(&v, a, sizeof v);
+  return v;
+}
+
+template <class V, class T>
+MPMVV_LANE_INLINE void store(T* a, const V& v) {
+  std::memcpy(a, &v, sizeof v);
+}
+
+template <class V>
+MPMVV_LANE_INLINE V lane_min(const V& a, const V& b) {
+  return a < b ? a : b;
+}
+template <class V>
+MPMVV_LANE_INLINE V lane_max(const V& a, const V& b) {
+  return a > b ? a : b;
+}
+
+// Lanes l0, ..., l0 + W - 1.
+template <int W>
+MPMVV_LANE_INLINE void lane_stencils(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneStencils& out, int l0) {
+  using Lanes = typename Width<W>::Lanes;
+  using Mask = typename Width<W>::Mask;
+  using Ints = typename Width<W>::Ints;
+  const Lanes zero = {};
+  const Lanes x = load<Lanes>(in.x + l0), y = load<Lanes>(in.y + l0);
+  const Lanes s00 = load<Lanes>(in.s00 + l0), s01 = load<Lanes>(in.s01 + l0);
+  const Lanes s10 = load<Lanes>(in.s10 + l0), s11 = load<Lanes>(in.s11 + l0);
+  // s^-T = [[s11, -s10], [-s01, s00]] / det s (corner_gradients).
+  const Lanes inv_det = g.gradient_scale / (s00 * s11 - s01 * s10);
+  const Ints last_i = Ints{} + (g.cells_x - 1), last_j = Ints{} + (g.cells_y - 1);
+
+  Ints cell_i[4], cell_j[4];
+  Lanes fx[4], fy[4], grad_x[4], grad_y[4];
+  double corner_weight[4];
+  for (int c = 0; c < 4; ++c) {
+    const double xi = kCornerXi[c], eta = kCornerEta[c];
+    corner_weight[c] = 0.25 * (1.0 + g.weight_skew * xi);
+    const double gxi = 0.25 * xi, geta = 0.25 * eta;
+    grad_x[c] = inv_det * (s11 * gxi - s10 * geta);
+    grad_y[c] = inv_det * (s00 * geta - s01 * gxi);
+    // The corner x_p + xi r_1 + eta r_2 in grid coordinates, its cell and
+    // its place in the cell.
+    const Lanes cx = (x + xi * s00 + eta * s01 - g.origin_x) / g.h;
+    const Lanes cy = (y + xi * s10 + eta * s11 - g.origin_y) / g.h;
+    cell_i[c] = lane_min(__builtin_convertvector(cx, Ints), last_i);
+    cell_j[c] = lane_min(__builtin_convertvector(cy, Ints), last_j);
+    fx[c] = cx - __builtin_convertvector(cell_i[c], Lanes);
+    fy[c] = cy - __builtin_convertvector(cell_j[c], Lanes);
+  }
+  const Ints i0 = lane_min(lane_min(cell_i[0], cell_i[1]), lane_min(cell_i[2], cell_i[3]));
+  const Ints j0 = lane_min(lane_min(cell_j[0], cell_j[1]), lane_min(cell_j[2], cell_j[3]));
+  store(out.i0 + l0, i0);
+  store(out.j0 + l0, j0);
+  store(out.span_i + l0, lane_max(lane_max(cell_i[0], cell_i[1]), lane_max(cell_i[2], cell_i[3])) - i0);
+  store(out.span_j + l0, lane_max(lane_max(cell_j[0], cell_j[1]), lane_max(cell_j[2], cell_j[3])) - j0);
+
+  // Corner c's hat factors along x at the nodes i0, i0 + 1, i0 + 2: in its
+  // own cell (offset 0 or 1 from i0) 1 - fx and fx, elsewhere 0; the same
+  // along y. Their products are evaluate's bilinear weights b_k.
+  Lanes along_x[4][3], along_y[4][3];
+  for (int c = 0; c < 4; ++c) {
+    const Mask first_x = __builtin_convertvector(cell_i[c] - i0, Lanes) == zero;
+    const Mask first_y = __builtin_convertvector(cell_j[c] - j0, Lanes) == zero;
+    const Lanes gx = 1.0 - fx[c], gy = 1.0 - fy[c];
+    along_x[c][0] = first_x ? gx : zero;
+    along_x[c][1] = first_x ? fx[c] : gx;
+    along_x[c][2] = first_x ? zero : fx[c];
+    along_y[c][0] = first_y ? gy : zero;
+    along_y[c][1] = first_y ? fy[c] : gy;
+    along_y[c][2] = first_y ? zero : fy[c];
+  }
+  for (int b = 0; b < 3; ++b)
+    for (int a = 0; a < 3; ++a) {
+      Lanes w = zero, gsx = zero, gsy = zero;
+      for (int c = 0; c < 4; ++c) {
+        const Lanes share = along_x[c][a] * along_y[c][b];
+        w += corner_weight[c] * share;
+        gsx += grad_x[c] * share;
+        gsy += grad_y[c] * share;
+      }
+      store(out.weight[a + 3 * b] + l0, w);
+      store(out.gradient_x[a + 3 * b] + l0, gsx);
+      store(out.gradient_y[a + 3 * b] + l0, gsy);
+    }
+}
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#define MPMVV_LANE_X86 1
+__attribute__((target("avx512f"))) void lane_stencils_avx512f(const CpdiLaneGrid& g, const CpdiLaneInput& in,
+                                                              CpdiLaneStencils& out) {
+  lane_stencils<8>(g, in, out, 0);
+}
+__attribute__((target("avx2"))) void lane_stencils_avx2(const CpdiLaneGrid& g, const CpdiLaneInput& in,
+                                                        CpdiLaneStencils& out) {
+  for (int l0 = 0; l0 < kCpdiLanes; l0 += 4) lane_stencils<4>(g, in, out, l0);
+}
+#endif
+void lane_stencils_baseline(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneStencils& out) {
+  for (int l0 = 0; l0 < kCpdiLanes; l0 += 2) lane_stencils<2>(g, in, out, l0);
+}
+
+using Kernel = void (*)(const CpdiLaneGrid&, const CpdiLaneInput&, CpdiLaneStencils&);
+
+Kernel kernel_of(LaneBuild build) {
+  switch (build) {
+#ifdef MPMVV_LANE_X86
+    case LaneBuild::avx512f: return lane_stencils_avx512f;
+    case LaneBuild::avx2: return lane_stencils_avx2;
+#endif
+    default: return lane_stencils_baseline;
+  }
+}
+
+// Chosen once, when the program starts.
+const Kernel widest_kernel = kernel_of(widest_lane_build());
+
+}  // namespace
+
+bool cpu_has(LaneBuild build) {
+#ifdef MPMVV_LANE_X86
+  __builtin_cpu_init();
+  switch (build) {
+    case LaneBuild::avx512f: return __builtin_cpu_supports("avx512f");
+    case LaneBuild::avx2: return __builtin_cpu_supports("avx2");
+    case LaneBuild::baseline: return true;
+  }
+  return false;
+#else
+  return build == LaneBuild::baseline;
+#endif
+}
+
+LaneBuild widest_lane_build() {
+  for (LaneBuild b : {LaneBuild::avx512f, LaneBuild::avx2})
+    if (cpu_has(b)) return b;
+  return LaneBuild::baseline;
+}
+
+const char* name(LaneBuild build) {
+  switch (build) {
+    case LaneBuild::avx512f: return "avx512f";
+    case LaneBuild::avx2: return "avx2";
+    case LaneBuild::baseline: return "baseline";
+  }
+  return "?";
+}
+
+void cpdi_lane_stencils(const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiLaneStencils& out) {
+  widest_kernel(grid, in, out);
+}
+
+void cpdi_lane_stencils(LaneBuild build, const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiLaneStencils& out) {
+  kernel_of(build)(grid, in, out);
+}
+
+}  // namespace mpmvv

@@ -1,0 +1,71 @@
+// The CPDI stencil of eight particles at once, each in a lane of one vector:
+// the same sums as CpdiShapeT::evaluate (cpdi.hpp, after
+// 002_c3305cb8b1bc1490.txt eqs. 1.95-1.100), for plane-strain parallelogram
+// domains, with every corner's bilinear weights summed into the 3 x 3 nodes
+// from the domain's lowest corner cell.
+//
+// Why lanes: a particle's stencil is four corners of the same arithmetic,
+// whose merge into shared nodes indexes a small array by each corner's cell
+// and so chains every sum through memory. Written instead as a sum over the
+// nine nodes of selected corner weights (a corner that does not reach a node
+// adds zero), it has no index that depends on the data and runs on as many
+// particles as the vector holds. The kernel is built for AVX-512, for AVX2
+// and for any x86-64 (LaneBuild), and the widest the CPU has is chosen once,
+// when the program starts. Every product and sum is the one evaluate forms,
+// in the same order, so the stencils are the same to the last bit (zero
+// terms added to a sum change nothing).
+//
+// The sums are kept apart from fused multiply-adds (solver/CMakeLists.txt),
+// which AVX-512 has and the scalar code does not use.
+//
+// A lane whose corners span more than 2 x 2 cells (a domain stretched past a
+// cell) is marked by its span and left to evaluate.
+#pragma once
+
+namespace mpmvv {
+
+inline constexpr int kCpdiLanes = 8;
+
+// The grid and the method's factors, the same for every lane.
+struct CpdiLaneGrid {
+  double origin_x, origin_y, h;
+  int cells_x, cells_y;        // ghost layers included
+  double gradient_scale;       // CpdiShapeT::gradient_scale
+  double weight_skew;          // CpdiShapeT::weight_skew
+};
+
+// Each lane's centre x_p and domain s_p = [r_1 r_2] (eq. 1.97).
+struct CpdiLaneInput {
+  alignas(64) double x[kCpdiLanes];
+  alignas(64) double y[kCpdiLanes];
+  alignas(64) double s00[kCpdiLanes];
+  alignas(64) double s01[kCpdiLanes];
+  alignas(64) double s10[kCpdiLanes];
+  alignas(64) double s11[kCpdiLanes];
+};
+
+// S_gp and G_gp of node (i0 + a, j0 + b) in slot a + 3 b, and the spans of
+// the corners' cells: a lane with a span over 1 holds no stencil.
+struct CpdiLaneStencils {
+  alignas(64) double weight[9][kCpdiLanes];
+  alignas(64) double gradient_x[9][kCpdiLanes];
+  alignas(64) double gradient_y[9][kCpdiLanes];
+  alignas(32) int i0[kCpdiLanes];
+  alignas(32) int j0[kCpdiLanes];
+  alignas(32) int span_i[kCpdiLanes];
+  alignas(32) int span_j[kCpdiLanes];
+};
+
+// The builds of the kernel: the same source compiled for the baseline x86-64
+// (SSE2), for AVX2 and for AVX-512. All give the same bits.
+enum class LaneBuild { baseline, avx2, avx512f };
+
+bool cpu_has(LaneBuild build);
+LaneBuild widest_lane_build();  // the one cpdi_lane_stencils runs, chosen once
+const char* name(LaneBuild build);
+
+void cpdi_lane_stencils(const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiLaneStencils& out);
+// The same with a given build, which the CPU must have (cpu_has).
+void cpdi_lane_stencils(LaneBuild build, const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiLaneStencils& out);
+
+}  // namespace mpmvv

@@ -1,0 +1,128 @@
+// The CPDI stencils of the lane kernel (solver/shape/cpdi_lanes.hpp) against
+// the scalar CpdiShapeT::evaluate, bit for bit, for every build of the kernel
+// this CPU can run: the explicit step takes its stencils from the kernel, and
+// its results are meant to be those of the scalar code to the last bit.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "solver/shape/cpdi.hpp"
+#include "solver/shape/cpdi_lanes.hpp"
+
+namespace {
+
+using mpmvv::CpdiShape;
+using mpmvv::CpdiShapeT;
+using mpmvv::CpdiForm;
+using mpmvv::Geometry;
+using mpmvv::GridGeometry;
+using mpmvv::LaneBuild;
+using mpmvv::Mat2;
+using mpmvv::Particles;
+using mpmvv::Stencil;
+using mpmvv::Vec2;
+
+std::uint64_t bits(double x) { return std::bit_cast<std::uint64_t>(x); }
+
+// Particles spread over a 20 x 20-cell grid with random deformation
+// gradients: small strains, shears that stretch a domain past a cell (the
+// kernel leaves those to evaluate), and one folded domain (det F < 0).
+Particles random_particles(const GridGeometry& grid, std::size_t n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> where(6.0, 14.0), strain(-0.3, 0.3), shear(-3.0, 3.0);
+  Particles P;
+  P.resize(n);
+  P.half_size.resize(n);
+  for (std::size_t p = 0; p < n; ++p) {
+    P.position[p] = grid.origin + grid.h * Vec2(where(rng), where(rng));
+    P.half_size[p] = Vec2(0.25 * grid.h, 0.25 * grid.h);
+    Mat2 F;
+    F << 1.0 + strain(rng), strain(rng), strain(rng), 1.0 + strain(rng);
+    if (p % 5 == 0) F(0, 1) = shear(rng);  // a domain several cells long
+    if (p == 7) F(0, 0) = -1.0;            // turned over
+    P.deformation_gradient[p] = F;
+    P.volume[p] = P.reference_volume[p] = 0.25 * grid.h * grid.h;
+  }
+  return P;
+}
+
+template <class Shape>
+void expect_lanes_equal_evaluate(const Shape& shape, std::size_t n, LaneBuild build) {
+  constexpr int N = Shape::stencil_size;
+  std::size_t compared = 0, wide = 0;
+  for (std::size_t first = 0; first < n; first += mpmvv::kCpdiLanes) {
+    const int count = int(std::min<std::size_t>(mpmvv::kCpdiLanes, n - first));
+    bool use[mpmvv::kCpdiLanes];
+    for (int l = 0; l < mpmvv::kCpdiLanes; ++l) use[l] = (first + std::size_t(l)) % 11 != 3;  // some skipped
+    Stencil<N> lanes[mpmvv::kCpdiLanes];
+    for (auto& s : lanes) s.count = -1;
+    shape.evaluate_lanes(first, count, use, lanes, &build);
+    for (int l = 0; l < count; ++l) {
+      const std::size_t p = first + std::size_t(l);
+      if (!use[l]) {
+        EXPECT_EQ(lanes[l].count, -1) << "particle " << p << " was to be skipped";
+        continue;
+      }
+      Stencil<N> scalar;
+      shape.evaluate(p, scalar);
+      ASSERT_EQ(lanes[l].count, scalar.count) << "particle " << p << ", build " << mpmvv::name(build);
+      if (scalar.count == N) ++wide;
+      for (int k = 0; k < scalar.count; ++k) {
+        EXPECT_EQ(lanes[l].node[k], scalar.node[k]) << "particle " << p << " entry " << k;
+        EXPECT_EQ(bits(lanes[l].weight[k]), bits(scalar.weight[k])) << "particle " << p << " entry " << k;
+        EXPECT_EQ(bits(lanes[l].gradient[k].x()), bits(scalar.gradient[k].x())) << "particle " << p << " entry " << k;
+        EXPECT_EQ(bits(lanes[l].gradient[k].y()), bits(scalar.gradient[k].y())) << "particle " << p << " entry " << k;
+      }
+      ++compared;
+    }
+  }
+  // The comparison covered both kinds of stencil, merged and full.
+  EXPECT_GT(compared, n / 2);
+  EXPECT_GT(wide, 0u);
+  EXPECT_GT(compared - wide, n / 4);
+}
+
+std::vector<LaneBuild> builds_of_this_cpu() {
+  std::vector<LaneBuild> builds;
+  for (LaneBuild b : {LaneBuild::baseline, LaneBuild::avx2, LaneBuild::avx512f})
+    if (mpmvv::cpu_has(b)) builds.push_back(b);
+  return builds;
+}
+
+TEST(CpdiLanes, EveryBuildGivesTheScalarStencilsBitForBit) {
+  const GridGeometry grid = GridGeometry::walled(Vec2(-0.3, 0.1), 0.05, 18, 18);
+  const Particles P = random_particles(grid, 203, 5);  // 25 lanes of 8 and 3 over
+  ASSERT_FALSE(builds_of_this_cpu().empty());
+  for (LaneBuild build : builds_of_this_cpu()) {
+    SCOPED_TRACE(mpmvv::name(build));
+    expect_lanes_equal_evaluate(CpdiShape::bind(grid, P), P.size(), build);
+    // The deliberate faults' factors (faults.hpp) go through the kernel too.
+    CpdiShape faulty = CpdiShape::bind(grid, P, nullptr, 1.5);
+    faulty.weight_skew = 0.2;
+    expect_lanes_equal_evaluate(faulty, P.size(), build);
+  }
+}
+
+TEST(CpdiLanes, TurnedDomainsTooBitForBit) {
+  const GridGeometry grid = GridGeometry::walled(Vec2(0.0, 0.0), 0.1, 18, 18);
+  Particles P = random_particles(grid, 64, 9);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> turn(-0.8, 0.8);
+  P.domain_axes.resize(P.size());
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    const double c = std::cos(turn(rng)), s = std::sin(turn(rng));
+    P.domain_axes[p] << 0.25 * grid.h * c, -0.2 * grid.h * s, 0.25 * grid.h * s, 0.2 * grid.h * c;
+  }
+  using Turned = CpdiShapeT<Geometry::plane_strain, CpdiForm::turned>;
+  for (LaneBuild build : builds_of_this_cpu()) {
+    SCOPED_TRACE(mpmvv::name(build));
+    expect_lanes_equal_evaluate(Turned::bind(grid, P), P.size(), build);
+  }
+}
+
+}  // namespace
