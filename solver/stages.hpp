@@ -101,8 +101,8 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
     std::fill(sums, sums + nodes, NodeSums{0.0, 0.0, 0.0, 0.0, 0.0});
     [[maybe_unused]] double max_speed = 0.0;
     [[maybe_unused]] std::size_t first_unhealthy = P.size();
-    auto map = [&](std::size_t p, const Stencil<Shape::stencil_size>& s) {
-      if constexpr (scanning) max_speed = std::max(max_speed, scan->speed(p, s, max_speed));
+    auto map = [&](std::size_t p, const Stencil<Shape::stencil_size>& s, double gradient_bound) {
+      if constexpr (scanning) max_speed = std::max(max_speed, scan->speed(p, s, max_speed, gradient_bound));
       const double m = P.mass[p];
       Vec2 momentum = Vec2::Zero(), body = Vec2::Zero();
       Mat2 volume_stress = Mat2::Zero();
@@ -148,13 +148,14 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
       // static schedule gives this thread, in the same order.
       const auto [first, last] = static_block(range.first, n);
       Stencil<Shape::stencil_size> s[kCpdiLanes];
+      double gradient_bound[kCpdiLanes];
       for (std::size_t p0 = first; p0 < last; p0 += kCpdiLanes) {
         const int count = int(std::min<std::size_t>(kCpdiLanes, last - p0));
         bool use[kCpdiLanes];
         for (int l = 0; l < count; ++l) use[l] = usable(p0 + std::size_t(l));
-        shape.evaluate_lanes(p0, count, use, s);
+        shape.evaluate_lanes(p0, count, use, s, scanning ? gradient_bound : nullptr);
         for (int l = 0; l < count; ++l)
-          if (use[l]) map(p0 + std::size_t(l), s[l]);
+          if (use[l]) map(p0 + std::size_t(l), s[l], gradient_bound[l]);
       }
 #pragma omp barrier
     } else {
@@ -163,7 +164,7 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
       for (std::size_t p = range.first; p < n; ++p) {
         if (!usable(p)) continue;
         shape.evaluate(p, s);
-        map(p, s);
+        map(p, s, -1.0);
       }
     }
     if constexpr (scanning) {
@@ -624,22 +625,6 @@ double entry_gradient_sum(const Stencil<N>& s) {
   return sum;
 }
 
-// An upper bound of the same without a square root, entry by entry
-// |G| <= max(|G_x|, |G_y|) + (sqrt 2 - 1) min(|G_x|, |G_y|) (the chord of the
-// convex sqrt(1 + t^2) over t in [0, 1], equal at its ends): the scan runs it
-// for every particle every step, where nine square roots in a row cost more
-// than the rest of the particle's test.
-template <int N>
-double entry_gradient_sum_bound(const Stencil<N>& s) {
-  constexpr double kOctagon = 0.41421356237309515;  // sqrt 2 - 1, rounded up
-  double sum = 0.0;
-  for (int k = 0; k < s.count; ++k) {
-    const double x = std::abs(s.gradient[k].x()), y = std::abs(s.gradient[k].y());
-    sum += std::max(x, y) + kOctagon * std::min(x, y);
-  }
-  return sum;
-}
-
 // The same for particle p's stencil, evaluated here.
 template <class Shape>
 double gradient_sum(const Shape& shape, std::size_t p) {
@@ -704,21 +689,31 @@ double stiffening(const Stencil<N>& s, double h) {
 // particle left out is one whose speed could not have changed the maximum.
 template <class Shape, class Material>
 double signal_speed(const Shape& shape, const Material& material, const Particles& P, double h, std::size_t p,
-                    double largest, const Stencil<Shape::stencil_size>* stencil = nullptr) {
+                    double largest, const Stencil<Shape::stencil_size>* stencil = nullptr,
+                    double stencil_gradient_bound = -1.0) {
   const double density = P.mass[p] / P.volume[p];
   const double F33 = out_of_plane_stretch<Shape::geometry>(P, p);
   const double v = P.velocity[p].norm();
   // With the stencil at hand the bound of k_p is its sum of |G| over entries,
   // which is k_p's own sum where no node repeats (a stencil that is not full);
   // the test that rules a particle out reads a bound of that sum without
-  // square roots (entry_gradient_sum_bound) and the sum itself only if it
-  // has to.
+  // square roots (entry_gradient_sum_bound, or the caller's
+  // `stencil_gradient_bound` of the same stencil) and the sum itself only if
+  // it has to.
   [[maybe_unused]] double most = 1.0;
   [[maybe_unused]] bool most_exact = true;
   if constexpr (Shape::gradients_beyond_grid_basis) {
-    const double bound = stencil ? entry_gradient_sum_bound(*stencil) : shape.gradient_sum_bound(p);
-    most = std::max(1.0, h * bound / kGridBasisGradientBound);
-    most_exact = !stencil || most == 1.0;  // a bound under 1 leaves k_p's own bound at 1 too
+    if (stencil) {
+      const double bound =
+          stencil_gradient_bound >= 0.0 ? stencil_gradient_bound : entry_gradient_sum_bound(*stencil);
+      // h bound / (2 + sqrt 2), lifted past what its rounding could take off:
+      // where it is 1, k_p's own bound, no larger, is 1 too.
+      constexpr double inverse = 1.0 / kGridBasisGradientBound;
+      most = std::max(1.0, h * bound * inverse * (1.0 + 1e-12));
+      most_exact = most == 1.0;
+    } else {
+      most = std::max(1.0, h * shape.gradient_sum_bound(p) / kGridBasisGradientBound);
+    }
   }
   if constexpr (!requires { shape.cell_stretch(p); } &&
                 requires { material.wave_modulus_bound(P.deformation_gradient[p], F33, P.stress[p]); }) {
@@ -781,8 +776,11 @@ struct ScanInMap {
   ParticleScan result{0.0, P.size()};
 
   bool healthy(std::size_t p) const { return particle_healthy(shape, P, p); }
-  double speed(std::size_t p, const Stencil<Shape::stencil_size>& s, double largest) const {
-    return signal_speed(shape, material, P, h, p, largest, &s);
+  // `gradient_bound`: the stencil's entry_gradient_sum_bound where the
+  // caller has it, else negative.
+  double speed(std::size_t p, const Stencil<Shape::stencil_size>& s, double largest,
+               double gradient_bound = -1.0) const {
+    return signal_speed(shape, material, P, h, p, largest, &s, gradient_bound);
   }
 };
 

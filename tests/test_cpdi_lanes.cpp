@@ -61,7 +61,8 @@ void expect_lanes_equal_evaluate(const Shape& shape, std::size_t n, LaneBuild bu
     for (int l = 0; l < mpmvv::kCpdiLanes; ++l) use[l] = (first + std::size_t(l)) % 11 != 3;  // some skipped
     Stencil<N> lanes[mpmvv::kCpdiLanes];
     for (auto& s : lanes) s.count = -1;
-    shape.evaluate_lanes(first, count, use, lanes, &build);
+    double bound[mpmvv::kCpdiLanes];
+    shape.evaluate_lanes(first, count, use, lanes, bound, &build);
     for (int l = 0; l < count; ++l) {
       const std::size_t p = first + std::size_t(l);
       if (!use[l]) {
@@ -78,6 +79,13 @@ void expect_lanes_equal_evaluate(const Shape& shape, std::size_t n, LaneBuild bu
         EXPECT_EQ(bits(lanes[l].gradient[k].x()), bits(scalar.gradient[k].x())) << "particle " << p << " entry " << k;
         EXPECT_EQ(bits(lanes[l].gradient[k].y()), bits(scalar.gradient[k].y())) << "particle " << p << " entry " << k;
       }
+      // The time-step scan's bound of sum |G| over the entries: the one
+      // stencil.hpp forms, and above the sum of the lengths.
+      EXPECT_EQ(bits(bound[l]), bits(mpmvv::entry_gradient_sum_bound(scalar))) << "particle " << p;
+      double lengths = 0.0;
+      for (int k = 0; k < scalar.count; ++k) lengths += scalar.gradient[k].norm();
+      EXPECT_GE(bound[l], lengths) << "particle " << p;
+      EXPECT_LE(bound[l], 1.09 * lengths) << "particle " << p;
       ++compared;
     }
   }

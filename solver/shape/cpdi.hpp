@@ -293,8 +293,11 @@ struct CpdiShapeT {
   // particle whose `use` is false (one the scan found unhealthy, whose
   // domain may leave the grid) is read but not listed. `build` picks a build
   // of the kernel (tests); by default the widest the CPU has.
+  //
+  // `gradient_bound`, if given, receives for each particle an upper bound of
+  // sum_g |G_gp| (the time-step scan's; stages.hpp: entry_gradient_sum_bound).
   void evaluate_lanes(std::size_t first, int count, const bool* use, Stencil<stencil_size>* st,
-                      const LaneBuild* build = nullptr) const
+                      double* gradient_bound = nullptr, const LaneBuild* build = nullptr) const
     requires lanes
   {
     const GridGeometry& g = *grid;
@@ -318,8 +321,10 @@ struct CpdiShapeT {
       const int span_i = out.span_i[l], span_j = out.span_j[l];
       if (span_i > 1 || span_j > 1) {
         evaluate(first + std::size_t(l), st[l]);
+        if (gradient_bound) gradient_bound[l] = entry_gradient_sum_bound(st[l]);
         continue;
       }
+      if (gradient_bound) gradient_bound[l] = out.gradient_bound[l];
       // The nodes the corners reach, as evaluate lists them.
       int n = 0;
       for (int b = 0; b <= span_j + 1; ++b)

@@ -8,6 +8,7 @@
 #include <cstring>
 
 #include "../domain_corners.hpp"  // kCornerXi, kCornerEta
+#include "stencil.hpp"            // kOctagonFactor
 
 namespace mpmvv {
 
@@ -116,6 +117,8 @@ MPMVV_LANE_INLINE void lane_stencils(const CpdiLaneGrid& g, const CpdiLaneInput&
     along_y[c][1] = first_y ? fy[c] : gy;
     along_y[c][2] = first_y ? zero : fy[c];
   }
+  // The bound of stencil.hpp's entry_gradient_sum_bound over the nine.
+  Lanes bound = zero;
   for (int b = 0; b < 3; ++b)
     for (int a = 0; a < 3; ++a) {
       Lanes w = zero, gsx = zero, gsy = zero;
@@ -128,7 +131,10 @@ MPMVV_LANE_INLINE void lane_stencils(const CpdiLaneGrid& g, const CpdiLaneInput&
       store(out.weight[a + 3 * b] + l0, w);
       store(out.gradient_x[a + 3 * b] + l0, gsx);
       store(out.gradient_y[a + 3 * b] + l0, gsy);
+      const Lanes ax = gsx < zero ? -gsx : gsx, ay = gsy < zero ? -gsy : gsy;
+      bound += (ax > ay ? ax : ay) + kOctagonFactor * (ax > ay ? ay : ax);
     }
+  store(out.gradient_bound + l0, bound);
 }
 
 #if defined(__x86_64__) && defined(__GNUC__)

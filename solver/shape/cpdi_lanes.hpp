@@ -46,10 +46,13 @@ struct CpdiLaneInput {
 
 // S_gp and G_gp of node (i0 + a, j0 + b) in slot a + 3 b, and the spans of
 // the corners' cells: a lane with a span over 1 holds no stencil.
+// `gradient_bound` is an upper bound of sum_g |G_gp| over the nine, for the
+// time-step scan (stages.hpp: entry_gradient_sum_bound, the same bound).
 struct CpdiLaneStencils {
   alignas(64) double weight[9][kCpdiLanes];
   alignas(64) double gradient_x[9][kCpdiLanes];
   alignas(64) double gradient_y[9][kCpdiLanes];
+  alignas(64) double gradient_bound[kCpdiLanes];
   alignas(32) int i0[kCpdiLanes];
   alignas(32) int j0[kCpdiLanes];
   alignas(32) int span_i[kCpdiLanes];
