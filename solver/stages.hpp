@@ -147,11 +147,11 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
       // Eight stencils at a time (cpdi_lanes.hpp), over the particles the
       // static schedule gives this thread, in the same order.
       const auto [first, last] = static_block(range.first, n);
-      Stencil<Shape::stencil_size> s[kCpdiLanes];
-      double gradient_bound[kCpdiLanes];
-      for (std::size_t p0 = first; p0 < last; p0 += kCpdiLanes) {
-        const int count = int(std::min<std::size_t>(kCpdiLanes, last - p0));
-        bool use[kCpdiLanes];
+      Stencil<Shape::stencil_size> s[kLanes];
+      double gradient_bound[kLanes];
+      for (std::size_t p0 = first; p0 < last; p0 += kLanes) {
+        const int count = int(std::min<std::size_t>(kLanes, last - p0));
+        bool use[kLanes];
         for (int l = 0; l < count; ++l) use[l] = usable(p0 + std::size_t(l));
         shape.evaluate_lanes(p0, count, use, s, scanning ? gradient_bound : nullptr);
         for (int l = 0; l < count; ++l)
@@ -328,10 +328,10 @@ void grid_to_particles(const Shape& shape, const GridFields& g, Particles& P, do
     };
     if constexpr (evaluates_lanes<Shape>()) {
       const auto [first, last] = static_block(range.first, n);
-      Stencil<Shape::stencil_size> s[kCpdiLanes];
-      const bool use[kCpdiLanes] = {true, true, true, true, true, true, true, true};
-      for (std::size_t p0 = first; p0 < last; p0 += kCpdiLanes) {
-        const int count = int(std::min<std::size_t>(kCpdiLanes, last - p0));
+      Stencil<Shape::stencil_size> s[kLanes];
+      const bool use[kLanes] = {true, true, true, true, true, true, true, true};
+      for (std::size_t p0 = first; p0 < last; p0 += kLanes) {
+        const int count = int(std::min<std::size_t>(kLanes, last - p0));
         shape.evaluate_lanes(p0, count, use, s);
         for (int l = 0; l < count; ++l) update(p0 + std::size_t(l), s[l]);
       }

@@ -289,7 +289,7 @@ struct CpdiShapeT {
   static constexpr bool lanes = G == Geometry::plane_strain && !Corners;
 
   // The stencils of particles first, ..., first + count - 1 (count at most
-  // kCpdiLanes) into st[0], ..., st[count - 1], as evaluate gives them; a
+  // kLanes) into st[0], ..., st[count - 1], as evaluate gives them; a
   // particle whose `use` is false (one the scan found unhealthy, whose
   // domain may leave the grid) is read but not listed. `build` picks a build
   // of the kernel (tests); by default the widest the CPU has.
@@ -302,7 +302,7 @@ struct CpdiShapeT {
   {
     const GridGeometry& g = *grid;
     CpdiLaneInput in;
-    for (int l = 0; l < kCpdiLanes; ++l) {
+    for (int l = 0; l < kLanes; ++l) {
       const std::size_t p = first + std::size_t(l < count ? l : 0);  // spare lanes repeat the first
       const Mat2 s = domain(p);
       in.x[l] = position[p].x();

@@ -1,71 +1,33 @@
-// The lane kernel of cpdi_lanes.hpp, on GCC's vector types: one variable holds
-// a quantity of W lanes, W the width of the build's registers (8 doubles for
-// AVX-512, 4 for AVX2, 2 for SSE2), and the eight lanes are taken W at a time
-// so that the kernel's values stay in registers. Each line is the scalar
-// line of CpdiShapeT::evaluate it repeats.
+// The lane kernel of cpdi_lanes.hpp (lane_vectors.hpp says how it is built).
+// Each line is the scalar line of CpdiShapeT::evaluate it repeats.
 #include "cpdi_lanes.hpp"
 
-#include <cstring>
-
 #include "../domain_corners.hpp"  // kCornerXi, kCornerEta
-#include "stencil.hpp"            // kOctagonFactor
+#include "../lane_vectors.hpp"
+#include "stencil.hpp"  // kOctagonFactor
 
 namespace mpmvv {
 
 namespace {
 
-// Inlined into each build of the kernel, so that no vector crosses a call
-// (the warning is about how one would be passed if it did).
-#define MPMVV_LANE_INLINE inline __attribute__((always_inline))
-#pragma GCC diagnostic ignored "-Wpsabi"
+using lanes::lane_max;
+using lanes::lane_min;
+using lanes::load;
+using lanes::store;
+using lanes::Width;
 
-// W lanes of doubles, of their comparisons and of ints (one specialization
-// per width: GCC keeps a vector size only where it is not a template's).
-template <int W>
-struct Width;
-template <>
-struct Width<8> {
-  typedef double Lanes __attribute__((vector_size(64)));
-  typedef long long Mask __attribute__((vector_size(64)));
-  typedef int Ints __attribute__((vector_size(32)));
+struct CpdiKernel {
+  using Grid = CpdiLaneGrid;
+  using In = CpdiLaneInput;
+  using Out = CpdiLaneStencils;
+
+  template <int W>
+  MPMVV_LANE_INLINE static void body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneStencils& out, int l0);
 };
-template <>
-struct Width<4> {
-  typedef double Lanes __attribute__((vector_size(32)));
-  typedef long long Mask __attribute__((vector_size(32)));
-  typedef int Ints __attribute__((vector_size(16)));
-};
-template <>
-struct Width<2> {
-  typedef double Lanes __attribute__((vector_size(16)));
-  typedef long long Mask __attribute__((vector_size(16)));
-  typedef int Ints __attribute__((vector_size(8)));
-};
-
-template <class V>
-MPMVV_LANE_INLINE V load(const double* a) {
-  V v;
-  std::memcpy(&v, a, sizeof v);
-  return v;
-}
-
-template <class V, class T>
-MPMVV_LANE_INLINE void store(T* a, const V& v) {
-  std::memcpy(a, &v, sizeof v);
-}
-
-template <class V>
-MPMVV_LANE_INLINE V lane_min(const V& a, const V& b) {
-  return a < b ? a : b;
-}
-template <class V>
-MPMVV_LANE_INLINE V lane_max(const V& a, const V& b) {
-  return a > b ? a : b;
-}
 
 // Lanes l0, ..., l0 + W - 1.
 template <int W>
-MPMVV_LANE_INLINE void lane_stencils(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneStencils& out, int l0) {
+void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneStencils& out, int l0) {
   using Lanes = typename Width<W>::Lanes;
   using Mask = typename Width<W>::Mask;
   using Ints = typename Width<W>::Ints;
@@ -137,73 +99,14 @@ MPMVV_LANE_INLINE void lane_stencils(const CpdiLaneGrid& g, const CpdiLaneInput&
   store(out.gradient_bound + l0, bound);
 }
 
-#if defined(__x86_64__) && defined(__GNUC__)
-#define MPMVV_LANE_X86 1
-__attribute__((target("avx512f"))) void lane_stencils_avx512f(const CpdiLaneGrid& g, const CpdiLaneInput& in,
-                                                              CpdiLaneStencils& out) {
-  lane_stencils<8>(g, in, out, 0);
-}
-__attribute__((target("avx2"))) void lane_stencils_avx2(const CpdiLaneGrid& g, const CpdiLaneInput& in,
-                                                        CpdiLaneStencils& out) {
-  for (int l0 = 0; l0 < kCpdiLanes; l0 += 4) lane_stencils<4>(g, in, out, l0);
-}
-#endif
-void lane_stencils_baseline(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneStencils& out) {
-  for (int l0 = 0; l0 < kCpdiLanes; l0 += 2) lane_stencils<2>(g, in, out, l0);
-}
-
-using Kernel = void (*)(const CpdiLaneGrid&, const CpdiLaneInput&, CpdiLaneStencils&);
-
-Kernel kernel_of(LaneBuild build) {
-  switch (build) {
-#ifdef MPMVV_LANE_X86
-    case LaneBuild::avx512f: return lane_stencils_avx512f;
-    case LaneBuild::avx2: return lane_stencils_avx2;
-#endif
-    default: return lane_stencils_baseline;
-  }
-}
-
-// Chosen once, when the program starts.
-const Kernel widest_kernel = kernel_of(widest_lane_build());
-
 }  // namespace
 
-bool cpu_has(LaneBuild build) {
-#ifdef MPMVV_LANE_X86
-  __builtin_cpu_init();
-  switch (build) {
-    case LaneBuild::avx512f: return __builtin_cpu_supports("avx512f");
-    case LaneBuild::avx2: return __builtin_cpu_supports("avx2");
-    case LaneBuild::baseline: return true;
-  }
-  return false;
-#else
-  return build == LaneBuild::baseline;
-#endif
-}
-
-LaneBuild widest_lane_build() {
-  for (LaneBuild b : {LaneBuild::avx512f, LaneBuild::avx2})
-    if (cpu_has(b)) return b;
-  return LaneBuild::baseline;
-}
-
-const char* name(LaneBuild build) {
-  switch (build) {
-    case LaneBuild::avx512f: return "avx512f";
-    case LaneBuild::avx2: return "avx2";
-    case LaneBuild::baseline: return "baseline";
-  }
-  return "?";
-}
-
 void cpdi_lane_stencils(const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiLaneStencils& out) {
-  widest_kernel(grid, in, out);
+  lanes::run_lanes<CpdiKernel>(lanes::widest, grid, in, out);
 }
 
 void cpdi_lane_stencils(LaneBuild build, const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiLaneStencils& out) {
-  kernel_of(build)(grid, in, out);
+  lanes::run_lanes<CpdiKernel>(build, grid, in, out);
 }
 
 }  // namespace mpmvv

@@ -9,22 +9,18 @@
 // and so chains every sum through memory. Written instead as a sum over the
 // nine nodes of selected corner weights (a corner that does not reach a node
 // adds zero), it has no index that depends on the data and runs on as many
-// particles as the vector holds. The kernel is built for AVX-512, for AVX2
-// and for any x86-64 (LaneBuild), and the widest the CPU has is chosen once,
-// when the program starts. Every product and sum is the one evaluate forms,
-// in the same order, so the stencils are the same to the last bit (zero
-// terms added to a sum change nothing).
-//
-// The sums are kept apart from fused multiply-adds (solver/CMakeLists.txt),
-// which AVX-512 has and the scalar code does not use.
+// particles as the vector holds (lanes.hpp: built for AVX-512, AVX2 and any
+// x86-64). Every product and sum is the one evaluate forms, in the same
+// order, so the stencils are the same to the last bit (zero terms added to a
+// sum change nothing).
 //
 // A lane whose corners span more than 2 x 2 cells (a domain stretched past a
 // cell) is marked by its span and left to evaluate.
 #pragma once
 
-namespace mpmvv {
+#include "../lanes.hpp"
 
-inline constexpr int kCpdiLanes = 8;
+namespace mpmvv {
 
 // The grid and the method's factors, the same for every lane.
 struct CpdiLaneGrid {
@@ -36,12 +32,12 @@ struct CpdiLaneGrid {
 
 // Each lane's centre x_p and domain s_p = [r_1 r_2] (eq. 1.97).
 struct CpdiLaneInput {
-  alignas(64) double x[kCpdiLanes];
-  alignas(64) double y[kCpdiLanes];
-  alignas(64) double s00[kCpdiLanes];
-  alignas(64) double s01[kCpdiLanes];
-  alignas(64) double s10[kCpdiLanes];
-  alignas(64) double s11[kCpdiLanes];
+  alignas(64) double x[kLanes];
+  alignas(64) double y[kLanes];
+  alignas(64) double s00[kLanes];
+  alignas(64) double s01[kLanes];
+  alignas(64) double s10[kLanes];
+  alignas(64) double s11[kLanes];
 };
 
 // S_gp and G_gp of node (i0 + a, j0 + b) in slot a + 3 b, and the spans of
@@ -49,23 +45,15 @@ struct CpdiLaneInput {
 // `gradient_bound` is an upper bound of sum_g |G_gp| over the nine, for the
 // time-step scan (stages.hpp: entry_gradient_sum_bound, the same bound).
 struct CpdiLaneStencils {
-  alignas(64) double weight[9][kCpdiLanes];
-  alignas(64) double gradient_x[9][kCpdiLanes];
-  alignas(64) double gradient_y[9][kCpdiLanes];
-  alignas(64) double gradient_bound[kCpdiLanes];
-  alignas(32) int i0[kCpdiLanes];
-  alignas(32) int j0[kCpdiLanes];
-  alignas(32) int span_i[kCpdiLanes];
-  alignas(32) int span_j[kCpdiLanes];
+  alignas(64) double weight[9][kLanes];
+  alignas(64) double gradient_x[9][kLanes];
+  alignas(64) double gradient_y[9][kLanes];
+  alignas(64) double gradient_bound[kLanes];
+  alignas(32) int i0[kLanes];
+  alignas(32) int j0[kLanes];
+  alignas(32) int span_i[kLanes];
+  alignas(32) int span_j[kLanes];
 };
-
-// The builds of the kernel: the same source compiled for the baseline x86-64
-// (SSE2), for AVX2 and for AVX-512. All give the same bits.
-enum class LaneBuild { baseline, avx2, avx512f };
-
-bool cpu_has(LaneBuild build);
-LaneBuild widest_lane_build();  // the one cpdi_lane_stencils runs, chosen once
-const char* name(LaneBuild build);
 
 void cpdi_lane_stencils(const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiLaneStencils& out);
 // The same with a given build, which the CPU must have (cpu_has).

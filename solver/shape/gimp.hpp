@@ -14,6 +14,7 @@
 #include <cstddef>
 
 #include "../particles.hpp"
+#include "gimp_lanes.hpp"
 #include "linear.hpp"
 #include "stencil.hpp"
 
@@ -126,6 +127,45 @@ struct GimpShapeT {
         s.gradient[k] = Vec2(dx[a] * wy[b], wx[a] * dy[b]);
         if constexpr (G == Geometry::axisymmetric) s.hoop[k] = hx[a] * wy[b];
       }
+    }
+  }
+
+  // Plane strain evaluates eight particles at a time by the lane kernel
+  // (gimp_lanes.hpp), to the same bits as evaluate.
+  static constexpr bool lanes = G == Geometry::plane_strain;
+
+  // The stencils of particles first, ..., first + count - 1 (count at most
+  // kLanes) into st[0], ..., st[count - 1], as evaluate gives them; a particle
+  // whose `use` is false is read but not listed. `gradient_bound` (CPDI's,
+  // cpdi.hpp) is not needed for averages of the grid basis: -1 each.
+  void evaluate_lanes(std::size_t first, int count, const bool* use, Stencil<stencil_size>* st,
+                      double* gradient_bound = nullptr, const LaneBuild* build = nullptr) const
+    requires lanes
+  {
+    const GridGeometry& g = *grid;
+    GimpLaneInput in;
+    for (int l = 0; l < kLanes; ++l) {
+      const std::size_t p = first + std::size_t(l < count ? l : 0);  // spare lanes repeat the first
+      in.x[l] = position[p].x();
+      in.y[l] = position[p].y();
+      in.lx[l] = half_size[p].x();
+      in.ly[l] = half_size[p].y();
+    }
+    GimpLaneStencils out;
+    const GimpLaneGrid lane_grid{g.origin.x(), g.origin.y(), g.h, g.cells_x, g.cells_y};
+    if (build) gimp_lane_stencils(*build, lane_grid, in, out);
+    else gimp_lane_stencils(lane_grid, in, out);
+    for (int l = 0; l < count; ++l) {
+      if (gradient_bound) gradient_bound[l] = -1.0;
+      if (!use[l]) continue;
+      int k = 0;
+      for (int b = 0; b < 3; ++b)
+        for (int a = 0; a < 3; ++a, ++k) {
+          st[l].node[k] = g.node(out.node_i[a][l], out.node_j[b][l]);
+          st[l].weight[k] = out.weight[k][l];
+          st[l].gradient[k] = Vec2(out.gradient_x[k][l], out.gradient_y[k][l]);
+        }
+      st[l].count = stencil_size;
     }
   }
 

@@ -17,6 +17,7 @@
 #include <fmt/ranges.h>
 
 #include "solver/parallel.hpp"
+#include "solver/shape/cpdi_lanes.hpp"
 #include "tools/app/scene.hpp"
 
 int main(int argc, char** argv) {
@@ -41,7 +42,9 @@ int main(int argc, char** argv) {
              "{}\n",
              cells, scheme, end_time, extra.empty() ? "" : ", " + fmt::format("{}", fmt::join(extra, ", ")), repeats);
   fmt::print("ns: wall time per particle-step, then the same for each stage (stage_times.hpp; other: the time loop, "
-             "output, ledgers);\nbytes: what the particles and the stepper hold per particle\n");
+             "output, ledgers);\nbytes: what the particles and the stepper hold per particle; CPDI stencils by the {} "
+             "build of the lane kernel (solver/shape/cpdi_lanes.hpp)\n",
+             mpmvv::name(mpmvv::widest_lane_build()));
   fmt::print("{:>10} {:>7} {:>9} {:>6} {:>16} {:>7} | {:>6} {:>6} {:>6} {:>6} {:>6} {:>7} {:>6} | {:>5}\n", "method",
              "threads", "particles", "steps", "particle-steps/s", "ns", "map", "grid", "update", "stress", "scan",
              "forcing", "other", "bytes");

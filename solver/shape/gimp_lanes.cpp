@@ -1,0 +1,105 @@
+// The lane kernel of gimp_lanes.hpp (lane_vectors.hpp says how it is built).
+// Each line is the scalar line of gimp.hpp it repeats.
+#include "gimp_lanes.hpp"
+
+#include "../lane_vectors.hpp"
+
+namespace mpmvv {
+
+namespace {
+
+using lanes::lane_max;
+using lanes::lane_min;
+using lanes::load;
+using lanes::store;
+using lanes::Width;
+
+// gimp_weight_1d of each lane: the last piece first, then each earlier piece
+// where its test holds, so that the first test that holds decides, as in
+// the scalar chain of ifs.
+template <class Lanes, class Mask>
+MPMVV_LANE_INLINE void gimp_1d(const Lanes& d, double h, const Lanes& l, Lanes& w, Lanes& dw) {
+  const Lanes zero = {};
+  Lanes s = h + l - d;
+  w = s * s / (4.0 * h * l);
+  dw = -s / (2.0 * h * l);
+  Mask m = d <= h - l;
+  w = m ? 1.0 - d / h : w;
+  dw = m ? zero + -1.0 / h : dw;
+  m = d <= l;
+  w = m ? 1.0 - (d * d + l * l) / (2.0 * h * l) : w;
+  dw = m ? -d / (h * l) : dw;
+  m = d <= -l;
+  w = m ? 1.0 + d / h : w;
+  dw = m ? zero + 1.0 / h : dw;
+  m = d <= -h + l;
+  s = h + l + d;
+  w = m ? s * s / (4.0 * h * l) : w;
+  dw = m ? s / (2.0 * h * l) : dw;
+  m = (d <= -h - l) | (d > h + l);
+  w = m ? zero : w;
+  dw = m ? zero : dw;
+}
+
+struct GimpKernel {
+  using Grid = GimpLaneGrid;
+  using In = GimpLaneInput;
+  using Out = GimpLaneStencils;
+
+  template <int W>
+  MPMVV_LANE_INLINE static void body(const GimpLaneGrid& g, const GimpLaneInput& in, GimpLaneStencils& out, int l0);
+};
+
+// Lanes l0, ..., l0 + W - 1.
+template <int W>
+void GimpKernel::body(const GimpLaneGrid& g, const GimpLaneInput& in, GimpLaneStencils& out, int l0) {
+  using Lanes = typename Width<W>::Lanes;
+  using Mask = typename Width<W>::Mask;
+  using Ints = typename Width<W>::Ints;
+  const Lanes zero = {};
+  const Ints none = {};
+  const Lanes x = load<Lanes>(in.x + l0), y = load<Lanes>(in.y + l0);
+  const Lanes lx = load<Lanes>(in.lx + l0), ly = load<Lanes>(in.ly + l0);
+  const Lanes xi_x = (x - g.origin_x) / g.h, xi_y = (y - g.origin_y) / g.h;  // grid_coordinate
+  // floor(xi + 0.5) - 1: truncation, less one where it rounded up.
+  auto floor_int = [](const Lanes& v) {
+    const Ints t = __builtin_convertvector(v, Ints);
+    return t + __builtin_convertvector(__builtin_convertvector(t, Lanes) > v, Ints);
+  };
+  const Ints i0 = floor_int(xi_x + 0.5) - 1, j0 = floor_int(xi_y + 0.5) - 1;
+  const Ints last_i = none + g.cells_x, last_j = none + g.cells_y;
+  Lanes wx[3], dx[3], wy[3], dy[3];
+  for (int a = 0; a < 3; ++a) {
+    const Ints i = i0 + a, j = j0 + a;
+    const Mask in_x = __builtin_convertvector((i >= none) & (i <= last_i), Mask);
+    const Mask in_y = __builtin_convertvector((j >= none) & (j <= last_j), Mask);
+    store(out.node_i[a] + l0, lane_min(lane_max(i, none), last_i));
+    store(out.node_j[a] + l0, lane_min(lane_max(j, none), last_j));
+    const Lanes node_x = g.origin_x + __builtin_convertvector(i, Lanes) * g.h;
+    Lanes w, dw;
+    gimp_1d<Lanes, Mask>(x - node_x, g.h, lx, w, dw);
+    wx[a] = in_x ? w : zero;
+    dx[a] = in_x ? dw : zero;
+    gimp_1d<Lanes, Mask>((xi_y - __builtin_convertvector(j, Lanes)) * g.h, g.h, ly, w, dw);
+    wy[a] = in_y ? w : zero;
+    dy[a] = in_y ? dw : zero;
+  }
+  for (int b = 0; b < 3; ++b)
+    for (int a = 0; a < 3; ++a) {
+      store(out.weight[a + 3 * b] + l0, wx[a] * wy[b]);
+      store(out.gradient_x[a + 3 * b] + l0, dx[a] * wy[b]);
+      store(out.gradient_y[a + 3 * b] + l0, wx[a] * dy[b]);
+    }
+}
+
+}  // namespace
+
+void gimp_lane_stencils(const GimpLaneGrid& grid, const GimpLaneInput& in, GimpLaneStencils& out) {
+  lanes::run_lanes<GimpKernel>(lanes::widest, grid, in, out);
+}
+
+void gimp_lane_stencils(LaneBuild build, const GimpLaneGrid& grid, const GimpLaneInput& in, GimpLaneStencils& out) {
+  lanes::run_lanes<GimpKernel>(build, grid, in, out);
+}
+
+}  // namespace mpmvv

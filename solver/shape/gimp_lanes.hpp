@@ -1,0 +1,39 @@
+// The uGIMP stencil of eight particles at once (lanes.hpp): the same weights
+// and gradients as GimpShapeT::evaluate (gimp.hpp, eqs. 1.91-1.92 of
+// 002_c3305cb8b1bc1490.txt and their tensor product), plane strain, to the
+// last bit. Each of the six pieces of the 1D weight is formed in every lane
+// and the one the scalar code's first true test picks is kept, so the lanes
+// need no branch.
+#pragma once
+
+#include "../lanes.hpp"
+
+namespace mpmvv {
+
+struct GimpLaneGrid {
+  double origin_x, origin_y, h;
+  int cells_x, cells_y;  // ghost layers included
+};
+
+// Each lane's centre x_p and half-size l_p.
+struct GimpLaneInput {
+  alignas(64) double x[kLanes];
+  alignas(64) double y[kLanes];
+  alignas(64) double lx[kLanes];
+  alignas(64) double ly[kLanes];
+};
+
+// S_gp and G_gp of node (node_i[a], node_j[b]) in slot a + 3 b.
+struct GimpLaneStencils {
+  alignas(64) double weight[9][kLanes];
+  alignas(64) double gradient_x[9][kLanes];
+  alignas(64) double gradient_y[9][kLanes];
+  alignas(32) int node_i[3][kLanes];
+  alignas(32) int node_j[3][kLanes];
+};
+
+void gimp_lane_stencils(const GimpLaneGrid& grid, const GimpLaneInput& in, GimpLaneStencils& out);
+// The same with a given build, which the CPU must have (cpu_has).
+void gimp_lane_stencils(LaneBuild build, const GimpLaneGrid& grid, const GimpLaneInput& in, GimpLaneStencils& out);
+
+}  // namespace mpmvv
