@@ -133,10 +133,11 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
         }
       }
     };
-    // A particle the scan finds unhealthy is reported and skipped.
-    auto usable = [&](std::size_t p) {
+    // A particle the scan finds unhealthy is reported and skipped; `inside`
+    // is the shape's test of it (the lanes have it from their kernel).
+    auto usable = [&](std::size_t p, auto inside) {
       if constexpr (scanning) {
-        if (!scan->healthy(p)) {
+        if (!scan->healthy(p, inside)) {
           first_unhealthy = std::min(first_unhealthy, p);
           return false;
         }
@@ -144,25 +145,28 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
       return true;
     };
     if constexpr (evaluates_lanes<Shape>()) {
-      // Eight stencils at a time (cpdi_lanes.hpp), over the particles the
-      // static schedule gives this thread, in the same order.
+      // Eight stencils at a time (lanes.hpp), over the particles the static
+      // schedule gives this thread, in the same order.
       const auto [first, last] = static_block(range.first, n);
-      Stencil<Shape::stencil_size> s[kLanes];
-      double gradient_bound[kLanes];
+      typename Shape::LaneBatch batch;
+      Stencil<Shape::stencil_size> s;
       for (std::size_t p0 = first; p0 < last; p0 += kLanes) {
         const int count = int(std::min<std::size_t>(kLanes, last - p0));
-        bool use[kLanes];
-        for (int l = 0; l < count; ++l) use[l] = usable(p0 + std::size_t(l));
-        shape.evaluate_lanes(p0, count, use, s, scanning ? gradient_bound : nullptr);
-        for (int l = 0; l < count; ++l)
-          if (use[l]) map(p0 + std::size_t(l), s[l], gradient_bound[l]);
+        shape.compute_lanes(p0, count, batch);
+        for (int l = 0; l < count; ++l) {
+          const std::size_t p = p0 + std::size_t(l);
+          if (!usable(p, [&] { return shape.lane_inside(batch, l); })) continue;
+          double gradient_bound;
+          shape.list_lane(batch, l, s, gradient_bound);
+          map(p, s, gradient_bound);
+        }
       }
 #pragma omp barrier
     } else {
       Stencil<Shape::stencil_size> s;
 #pragma omp for schedule(static)
       for (std::size_t p = range.first; p < n; ++p) {
-        if (!usable(p)) continue;
+        if (!usable(p, [&] { return shape.inside(p); })) continue;
         shape.evaluate(p, s);
         map(p, s, -1.0);
       }
@@ -328,12 +332,16 @@ void grid_to_particles(const Shape& shape, const GridFields& g, Particles& P, do
     };
     if constexpr (evaluates_lanes<Shape>()) {
       const auto [first, last] = static_block(range.first, n);
-      Stencil<Shape::stencil_size> s[kLanes];
-      const bool use[kLanes] = {true, true, true, true, true, true, true, true};
+      typename Shape::LaneBatch batch;
+      Stencil<Shape::stencil_size> s;
       for (std::size_t p0 = first; p0 < last; p0 += kLanes) {
         const int count = int(std::min<std::size_t>(kLanes, last - p0));
-        shape.evaluate_lanes(p0, count, use, s);
-        for (int l = 0; l < count; ++l) update(p0 + std::size_t(l), s[l]);
+        shape.compute_lanes(p0, count, batch);
+        for (int l = 0; l < count; ++l) {
+          double gradient_bound;
+          shape.list_lane(batch, l, s, gradient_bound);
+          update(p0 + std::size_t(l), s);
+        }
       }
     } else {
       Stencil<Shape::stencil_size> s;
@@ -578,8 +586,11 @@ double out_of_plane_stretch(const Particles& P, std::size_t p) {
   return 1.0;
 }
 
-template <class Shape>
-bool particle_healthy(const Shape& shape, const Particles& P, std::size_t p) {
+// `inside`, if given, returns shape.inside(p) (a caller that has it cheaper
+// passes its own); it is asked only of a particle whose state is finite and
+// unfolded, as before.
+template <class Shape, class Inside = std::nullptr_t>
+bool particle_healthy(const Shape& shape, const Particles& P, std::size_t p, Inside inside = nullptr) {
   const double F33 = out_of_plane_stretch<Shape::geometry>(P, p);
   const double J = determinant(P.deformation_gradient[p]) * F33;
   // 0 x is +-0 for a finite x and NaN for an infinite or NaN one: the sum of
@@ -589,7 +600,9 @@ bool particle_healthy(const Shape& shape, const Particles& P, std::size_t p) {
                 0.0 * (P.velocity[p].y());
   for (int k = 0; k < 4; ++k) zero += 0.0 * P.deformation_gradient[p](k) + 0.0 * P.stress[p](k);
   if constexpr (Shape::geometry == Geometry::axisymmetric) zero += 0.0 * P.hoop_stress[p];
-  return zero == 0.0 && J > 0.0 && shape.inside(p);
+  if (!(zero == 0.0 && J > 0.0)) return false;
+  if constexpr (std::is_same_v<Inside, std::nullptr_t>) return shape.inside(p);
+  else return inside();
 }
 
 // The sum over nodes of |G_gp| of a stencil, each node counted once: a full
@@ -775,7 +788,10 @@ struct ScanInMap {
   double h;
   ParticleScan result{0.0, P.size()};
 
-  bool healthy(std::size_t p) const { return particle_healthy(shape, P, p); }
+  template <class Inside>
+  bool healthy(std::size_t p, Inside inside) const {
+    return particle_healthy(shape, P, p, inside);
+  }
   // `gradient_bound`: the stencil's entry_gradient_sum_bound where the
   // caller has it, else negative.
   double speed(std::size_t p, const Stencil<Shape::stencil_size>& s, double largest,

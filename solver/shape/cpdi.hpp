@@ -288,16 +288,21 @@ struct CpdiShapeT {
   // time by the lane kernel (cpdi_lanes.hpp), to the same bits as evaluate.
   static constexpr bool lanes = G == Geometry::plane_strain && !Corners;
 
-  // The stencils of particles first, ..., first + count - 1 (count at most
-  // kLanes) into st[0], ..., st[count - 1], as evaluate gives them; a
-  // particle whose `use` is false (one the scan found unhealthy, whose
-  // domain may leave the grid) is read but not listed. `build` picks a build
-  // of the kernel (tests); by default the widest the CPU has.
-  //
-  // `gradient_bound`, if given, receives for each particle an upper bound of
-  // sum_g |G_gp| (the time-step scan's; stages.hpp: entry_gradient_sum_bound).
-  void evaluate_lanes(std::size_t first, int count, const bool* use, Stencil<stencil_size>* st,
-                      double* gradient_bound = nullptr, const LaneBuild* build = nullptr) const
+  // Eight particles' stencils in two steps: compute_lanes runs the kernel on
+  // particles first, ..., first + count - 1 (count at most kLanes), then
+  // list_lane gives lane l's stencil as evaluate gives it, with an upper
+  // bound of its sum_g |G_gp| (the time-step scan's; stages.hpp:
+  // signal_speed). In between, lane_inside is `inside` of the lane's
+  // particle from the kernel's values, for the scan's health test: a
+  // particle that fails it is not listed (its domain may leave the grid).
+  // `build` picks a build of the kernel (tests); by default the widest the
+  // CPU has.
+  struct LaneBatch {
+    std::size_t first;
+    CpdiLaneStencils out;
+  };
+
+  void compute_lanes(std::size_t first, int count, LaneBatch& batch, const LaneBuild* build = nullptr) const
     requires lanes
   {
     const GridGeometry& g = *grid;
@@ -312,30 +317,40 @@ struct CpdiShapeT {
       in.s10[l] = s(1, 0);
       in.s11[l] = s(1, 1);
     }
-    CpdiLaneStencils out;
+    batch.first = first;
     const CpdiLaneGrid lane_grid{g.origin.x(), g.origin.y(), g.h, g.cells_x, g.cells_y, gradient_scale, weight_skew};
-    if (build) cpdi_lane_stencils(*build, lane_grid, in, out);
-    else cpdi_lane_stencils(lane_grid, in, out);
-    for (int l = 0; l < count; ++l) {
-      if (!use[l]) continue;
-      const int span_i = out.span_i[l], span_j = out.span_j[l];
-      if (span_i > 1 || span_j > 1) {
-        evaluate(first + std::size_t(l), st[l]);
-        if (gradient_bound) gradient_bound[l] = entry_gradient_sum_bound(st[l]);
-        continue;
-      }
-      if (gradient_bound) gradient_bound[l] = out.gradient_bound[l];
-      // The nodes the corners reach, as evaluate lists them.
-      int n = 0;
-      for (int b = 0; b <= span_j + 1; ++b)
-        for (int a = 0; a <= span_i + 1; ++a, ++n) {
-          const int slot = a + 3 * b;
-          st[l].node[n] = g.node(out.i0[l] + a, out.j0[l] + b);
-          st[l].weight[n] = out.weight[slot][l];
-          st[l].gradient[n] = Vec2(out.gradient_x[slot][l], out.gradient_y[slot][l]);
-        }
-      st[l].count = n;
+    if (build) cpdi_lane_stencils(*build, lane_grid, in, batch.out);
+    else cpdi_lane_stencils(lane_grid, in, batch.out);
+  }
+
+  bool lane_inside(const LaneBatch& batch, int l) const
+    requires lanes
+  {
+    return inside_walls(*grid, position[batch.first + std::size_t(l)]) && batch.out.box_inside[l] != 0;
+  }
+
+  void list_lane(const LaneBatch& batch, int l, Stencil<stencil_size>& st, double& gradient_bound) const
+    requires lanes
+  {
+    const GridGeometry& g = *grid;
+    const CpdiLaneStencils& out = batch.out;
+    const int span_i = out.span_i[l], span_j = out.span_j[l];
+    if (span_i > 1 || span_j > 1) {
+      evaluate(batch.first + std::size_t(l), st);
+      gradient_bound = entry_gradient_sum_bound(st);
+      return;
     }
+    gradient_bound = out.gradient_bound[l];
+    // The nodes the corners reach, as evaluate lists them.
+    int n = 0;
+    for (int b = 0; b <= span_j + 1; ++b)
+      for (int a = 0; a <= span_i + 1; ++a, ++n) {
+        const int slot = a + 3 * b;
+        st.node[n] = g.node(out.i0[l] + a, out.j0[l] + b);
+        st.weight[n] = out.weight[slot][l];
+        st.gradient[n] = Vec2(out.gradient_x[slot][l], out.gradient_y[slot][l]);
+      }
+    st.count = n;
   }
 
   // A corner domain turned over, 4 det [a_1 a_2] <= 0 (monitors.hpp:

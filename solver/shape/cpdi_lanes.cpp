@@ -38,6 +38,18 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
   // s^-T = [[s11, -s10], [-s01, s00]] / det s (corner_gradients).
   const Lanes inv_det = g.gradient_scale / (s00 * s11 - s01 * s10);
   const Ints last_i = Ints{} + (g.cells_x - 1), last_j = Ints{} + (g.cells_y - 1);
+  {
+    // CpdiShapeT::inside: the corners' bounding box in grid coordinates, in
+    // [0, cells] along both axes (inside_cells); NaN fails.
+    const Lanes reach_x = (s00 < zero ? -s00 : s00) + (s01 < zero ? -s01 : s01);
+    const Lanes reach_y = (s10 < zero ? -s10 : s10) + (s11 < zero ? -s11 : s11);
+    const Lanes low_x = (x - reach_x - g.origin_x) / g.h, low_y = (y - reach_y - g.origin_y) / g.h;
+    const Lanes high_x = (x + reach_x - g.origin_x) / g.h, high_y = (y + reach_y - g.origin_y) / g.h;
+    const double cells_x = g.cells_x, cells_y = g.cells_y;
+    const Mask inside = (low_x >= 0.0) & (low_x <= cells_x) & (low_y >= 0.0) & (low_y <= cells_y) &
+                        (high_x >= 0.0) & (high_x <= cells_x) & (high_y >= 0.0) & (high_y <= cells_y);
+    store(out.box_inside + l0, __builtin_convertvector(inside, Ints));
+  }
 
   Ints cell_i[4], cell_j[4];
   Lanes fx[4], fy[4], grad_x[4], grad_y[4];

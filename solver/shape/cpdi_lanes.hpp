@@ -14,6 +14,10 @@
 // order, so the stencils are the same to the last bit (zero terms added to a
 // sum change nothing).
 //
+// The kernel reads no memory by a lane's values, so a lane may hold any
+// state, NaN included: the caller tests the particle's health with the
+// kernel's own `box_inside` before it lists the stencil.
+//
 // A lane whose corners span more than 2 x 2 cells (a domain stretched past a
 // cell) is marked by its span and left to evaluate.
 #pragma once
@@ -49,6 +53,9 @@ struct CpdiLaneStencils {
   alignas(64) double gradient_x[9][kLanes];
   alignas(64) double gradient_y[9][kLanes];
   alignas(64) double gradient_bound[kLanes];
+  // The domain's bounding box, x_p -+ (|r_1| + |r_2|) along each axis, lies
+  // in the grid's cells (CpdiShapeT::inside without its test of the centre).
+  alignas(32) int box_inside[kLanes];
   alignas(32) int i0[kLanes];
   alignas(32) int j0[kLanes];
   alignas(32) int span_i[kLanes];

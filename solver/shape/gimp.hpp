@@ -134,12 +134,15 @@ struct GimpShapeT {
   // (gimp_lanes.hpp), to the same bits as evaluate.
   static constexpr bool lanes = G == Geometry::plane_strain;
 
-  // The stencils of particles first, ..., first + count - 1 (count at most
-  // kLanes) into st[0], ..., st[count - 1], as evaluate gives them; a particle
-  // whose `use` is false is read but not listed. `gradient_bound` (CPDI's,
-  // cpdi.hpp) is not needed for averages of the grid basis: -1 each.
-  void evaluate_lanes(std::size_t first, int count, const bool* use, Stencil<stencil_size>* st,
-                      double* gradient_bound = nullptr, const LaneBuild* build = nullptr) const
+  // Eight particles' stencils in two steps, as for CPDI (cpdi.hpp:
+  // compute_lanes). The gradient bound is CPDI's, which averages of the grid
+  // basis do not need: -1.
+  struct LaneBatch {
+    std::size_t first;
+    GimpLaneStencils out;
+  };
+
+  void compute_lanes(std::size_t first, int count, LaneBatch& batch, const LaneBuild* build = nullptr) const
     requires lanes
   {
     const GridGeometry& g = *grid;
@@ -151,22 +154,32 @@ struct GimpShapeT {
       in.lx[l] = half_size[p].x();
       in.ly[l] = half_size[p].y();
     }
-    GimpLaneStencils out;
+    batch.first = first;
     const GimpLaneGrid lane_grid{g.origin.x(), g.origin.y(), g.h, g.cells_x, g.cells_y};
-    if (build) gimp_lane_stencils(*build, lane_grid, in, out);
-    else gimp_lane_stencils(lane_grid, in, out);
-    for (int l = 0; l < count; ++l) {
-      if (gradient_bound) gradient_bound[l] = -1.0;
-      if (!use[l]) continue;
-      int k = 0;
-      for (int b = 0; b < 3; ++b)
-        for (int a = 0; a < 3; ++a, ++k) {
-          st[l].node[k] = g.node(out.node_i[a][l], out.node_j[b][l]);
-          st[l].weight[k] = out.weight[k][l];
-          st[l].gradient[k] = Vec2(out.gradient_x[k][l], out.gradient_y[k][l]);
-        }
-      st[l].count = stencil_size;
-    }
+    if (build) gimp_lane_stencils(*build, lane_grid, in, batch.out);
+    else gimp_lane_stencils(lane_grid, in, batch.out);
+  }
+
+  bool lane_inside(const LaneBatch& batch, int l) const
+    requires lanes
+  {
+    return inside(batch.first + std::size_t(l));
+  }
+
+  void list_lane(const LaneBatch& batch, int l, Stencil<stencil_size>& st, double& gradient_bound) const
+    requires lanes
+  {
+    const GridGeometry& g = *grid;
+    const GimpLaneStencils& out = batch.out;
+    gradient_bound = -1.0;
+    int k = 0;
+    for (int b = 0; b < 3; ++b)
+      for (int a = 0; a < 3; ++a, ++k) {
+        st.node[k] = g.node(out.node_i[a][l], out.node_j[b][l]);
+        st.weight[k] = out.weight[k][l];
+        st.gradient[k] = Vec2(out.gradient_x[k][l], out.gradient_y[k][l]);
+      }
+    st.count = stencil_size;
   }
 
   // The particle's centre lies between the walls and its domain inside the
