@@ -148,18 +148,21 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
       // Eight stencils at a time (lanes.hpp), over the particles the static
       // schedule gives this thread, in the same order.
       const auto [first, last] = static_block(range.first, n);
+      // All eight are listed before the first is weighed: a stencil read
+      // back as soon as it is written stalls on its stores.
       typename Shape::LaneBatch batch;
-      Stencil<Shape::stencil_size> s;
+      Stencil<Shape::stencil_size> s[kLanes];
+      double gradient_bound[kLanes];
+      bool use[kLanes];
       for (std::size_t p0 = first; p0 < last; p0 += kLanes) {
         const int count = int(std::min<std::size_t>(kLanes, last - p0));
-        shape.compute_lanes(p0, count, batch);
+        shape.compute_lanes(p0, count, batch, scanning);
         for (int l = 0; l < count; ++l) {
-          const std::size_t p = p0 + std::size_t(l);
-          if (!usable(p, [&] { return shape.lane_inside(batch, l); })) continue;
-          double gradient_bound;
-          shape.list_lane(batch, l, s, gradient_bound);
-          map(p, s, gradient_bound);
+          use[l] = usable(p0 + std::size_t(l), [&] { return shape.lane_inside(batch, l); });
+          if (use[l]) shape.list_lane(batch, l, s[l], gradient_bound[l]);
         }
+        for (int l = 0; l < count; ++l)
+          if (use[l]) map(p0 + std::size_t(l), s[l], gradient_bound[l]);
       }
 #pragma omp barrier
     } else {
@@ -333,15 +336,13 @@ void grid_to_particles(const Shape& shape, const GridFields& g, Particles& P, do
     if constexpr (evaluates_lanes<Shape>()) {
       const auto [first, last] = static_block(range.first, n);
       typename Shape::LaneBatch batch;
-      Stencil<Shape::stencil_size> s;
+      Stencil<Shape::stencil_size> s[kLanes];
       for (std::size_t p0 = first; p0 < last; p0 += kLanes) {
         const int count = int(std::min<std::size_t>(kLanes, last - p0));
-        shape.compute_lanes(p0, count, batch);
-        for (int l = 0; l < count; ++l) {
-          double gradient_bound;
-          shape.list_lane(batch, l, s, gradient_bound);
-          update(p0 + std::size_t(l), s);
-        }
+        shape.compute_lanes(p0, count, batch, false);
+        double gradient_bound;  // the scan's, not needed here
+        for (int l = 0; l < count; ++l) shape.list_lane(batch, l, s[l], gradient_bound);
+        for (int l = 0; l < count; ++l) update(p0 + std::size_t(l), s[l]);
       }
     } else {
       Stencil<Shape::stencil_size> s;

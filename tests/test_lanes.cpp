@@ -65,7 +65,7 @@ void expect_lanes_equal_evaluate(const Shape& shape, std::size_t n, LaneBuild bu
   for (std::size_t first = 0; first < n; first += mpmvv::kLanes) {
     const int count = int(std::min<std::size_t>(mpmvv::kLanes, n - first));
     typename Shape::LaneBatch batch;
-    shape.compute_lanes(first, count, batch, &build);
+    shape.compute_lanes(first, count, batch, true, &build);
     for (int l = 0; l < count; ++l) {
       const std::size_t p = first + std::size_t(l);
       // The scan's test of the domain, from the kernel's values.

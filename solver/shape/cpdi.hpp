@@ -295,14 +295,16 @@ struct CpdiShapeT {
   // signal_speed). In between, lane_inside is `inside` of the lane's
   // particle from the kernel's values, for the scan's health test: a
   // particle that fails it is not listed (its domain may leave the grid).
-  // `build` picks a build of the kernel (tests); by default the widest the
-  // CPU has.
+  // `test_box` asks the kernel for what lane_inside needs (the time-step
+  // scan), `build` for a build of the kernel (tests; by default the widest
+  // the CPU has).
   struct LaneBatch {
     std::size_t first;
     CpdiLaneStencils out;
   };
 
-  void compute_lanes(std::size_t first, int count, LaneBatch& batch, const LaneBuild* build = nullptr) const
+  void compute_lanes(std::size_t first, int count, LaneBatch& batch, bool test_box = true,
+                     const LaneBuild* build = nullptr) const
     requires lanes
   {
     const GridGeometry& g = *grid;
@@ -318,14 +320,15 @@ struct CpdiShapeT {
       in.s11[l] = s(1, 1);
     }
     batch.first = first;
-    const CpdiLaneGrid lane_grid{g.origin.x(), g.origin.y(), g.h, g.cells_x, g.cells_y, gradient_scale, weight_skew};
+    const CpdiLaneGrid lane_grid{g.origin.x(), g.origin.y(), g.h, g.cells_x, g.cells_y, gradient_scale, weight_skew,
+                                 test_box};
     if (build) cpdi_lane_stencils(*build, lane_grid, in, batch.out);
     else cpdi_lane_stencils(lane_grid, in, batch.out);
   }
 
   bool lane_inside(const LaneBatch& batch, int l) const
     requires lanes
-  {
+  {  // the batch computed with test_box
     return inside_walls(*grid, position[batch.first + std::size_t(l)]) && batch.out.box_inside[l] != 0;
   }
 

@@ -38,7 +38,7 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
   // s^-T = [[s11, -s10], [-s01, s00]] / det s (corner_gradients).
   const Lanes inv_det = g.gradient_scale / (s00 * s11 - s01 * s10);
   const Ints last_i = Ints{} + (g.cells_x - 1), last_j = Ints{} + (g.cells_y - 1);
-  {
+  if (g.test_box) {
     // CpdiShapeT::inside: the corners' bounding box in grid coordinates, in
     // [0, cells] along both axes (inside_cells); NaN fails.
     const Lanes reach_x = (s00 < zero ? -s00 : s00) + (s01 < zero ? -s01 : s01);

@@ -32,6 +32,7 @@ struct CpdiLaneGrid {
   int cells_x, cells_y;        // ghost layers included
   double gradient_scale;       // CpdiShapeT::gradient_scale
   double weight_skew;          // CpdiShapeT::weight_skew
+  bool test_box;               // fill CpdiLaneStencils::box_inside (four divisions a lane)
 };
 
 // Each lane's centre x_p and domain s_p = [r_1 r_2] (eq. 1.97).
@@ -54,7 +55,8 @@ struct CpdiLaneStencils {
   alignas(64) double gradient_y[9][kLanes];
   alignas(64) double gradient_bound[kLanes];
   // The domain's bounding box, x_p -+ (|r_1| + |r_2|) along each axis, lies
-  // in the grid's cells (CpdiShapeT::inside without its test of the centre).
+  // in the grid's cells (CpdiShapeT::inside without its test of the centre);
+  // only where CpdiLaneGrid::test_box asks for it.
   alignas(32) int box_inside[kLanes];
   alignas(32) int i0[kLanes];
   alignas(32) int j0[kLanes];

@@ -142,7 +142,8 @@ struct GimpShapeT {
     GimpLaneStencils out;
   };
 
-  void compute_lanes(std::size_t first, int count, LaneBatch& batch, const LaneBuild* build = nullptr) const
+  void compute_lanes(std::size_t first, int count, LaneBatch& batch, bool /*test_box*/ = true,
+                     const LaneBuild* build = nullptr) const
     requires lanes
   {
     const GridGeometry& g = *grid;
