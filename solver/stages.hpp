@@ -101,8 +101,11 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
     std::fill(sums, sums + nodes, NodeSums{0.0, 0.0, 0.0, 0.0, 0.0});
     [[maybe_unused]] double max_speed = 0.0;
     [[maybe_unused]] std::size_t first_unhealthy = P.size();
-    auto map = [&](std::size_t p, const Stencil<Shape::stencil_size>& s, double gradient_bound) {
-      if constexpr (scanning) max_speed = std::max(max_speed, scan->speed(p, s, max_speed, gradient_bound));
+    // `entries(f)` passes each entry of the particle's stencil to f;
+    // `stencil_of()` gives the stencil itself, which the scan asks for only
+    // where its bounds do not settle the particle's speed.
+    auto map = [&](std::size_t p, auto&& entries, auto&& stencil_of, double gradient_bound) {
+      if constexpr (scanning) max_speed = std::max(max_speed, scan->speed(p, stencil_of, max_speed, gradient_bound));
       const double m = P.mass[p];
       Vec2 momentum = Vec2::Zero(), body = Vec2::Zero();
       Mat2 volume_stress = Mat2::Zero();
@@ -111,12 +114,11 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
       if constexpr (with_body) body = m * P.body_force[p];
       if constexpr (with_internal) volume_stress = P.volume[p] * P.stress[p];
       if constexpr (with_internal && axisymmetric) volume_hoop_stress = P.volume[p] * P.hoop_stress[p];
-      for (int k = 0; k < s.count; ++k) {
-        NodeSums& node = sums[s.node[k]];
-        const double w = s.weight[k];
+      entries([&](int i, double w, const Vec2& gradient, const double& hoop = 0.0) {
+        NodeSums& node = sums[i];
         if constexpr (with_mass) node.mass += w * m;
         if constexpr (with_affine) {
-          const Vec2 affine = momentum + m * (P.affine_velocity[p] * (grid->node_position(s.node[k]) - P.position[p]));
+          const Vec2 affine = momentum + m * (P.affine_velocity[p] * (grid->node_position(i) - P.position[p]));
           node.momentum_x += w * affine.x();
           node.momentum_y += w * affine.y();
         } else if constexpr (with_momentum) {
@@ -125,13 +127,13 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
         }
         if constexpr (with_force) {
           Vec2 f = Vec2::Zero();
-          if constexpr (with_internal) f -= volume_stress * s.gradient[k];
-          if constexpr (with_internal && axisymmetric) f.x() -= volume_hoop_stress * s.hoop[k];
+          if constexpr (with_internal) f -= volume_stress * gradient;
+          if constexpr (with_internal && axisymmetric) f.x() -= volume_hoop_stress * hoop;
           if constexpr (with_body) f += w * body;
           node.force_x += f.x();
           node.force_y += f.y();
         }
-      }
+      });
     };
     // A particle the scan finds unhealthy is reported and skipped; `inside`
     // is the shape's test of it (the lanes have it from their kernel).
@@ -144,34 +146,44 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
       }
       return true;
     };
+    Stencil<Shape::stencil_size> s;
+    auto stencil_s = [&]() -> const Stencil<Shape::stencil_size>& { return s; };
     if constexpr (evaluates_lanes<Shape>()) {
       // Eight stencils at a time (lanes.hpp), over the particles the static
-      // schedule gives this thread, in the same order.
+      // schedule gives this thread, in the same order; the kernel's entries
+      // are weighed as they stand, and listed as a stencil only for the scan
+      // that asks for one.
       const auto [first, last] = static_block(range.first, n);
-      // All eight are listed before the first is weighed: a stencil read
-      // back as soon as it is written stalls on its stores.
       typename Shape::LaneBatch batch;
-      Stencil<Shape::stencil_size> s[kLanes];
-      double gradient_bound[kLanes];
-      bool use[kLanes];
       for (std::size_t p0 = first; p0 < last; p0 += kLanes) {
         const int count = int(std::min<std::size_t>(kLanes, last - p0));
         shape.compute_lanes(p0, count, batch, scanning);
         for (int l = 0; l < count; ++l) {
-          use[l] = usable(p0 + std::size_t(l), [&] { return shape.lane_inside(batch, l); });
-          if (use[l]) shape.list_lane(batch, l, s[l], gradient_bound[l]);
+          const std::size_t p = p0 + std::size_t(l);
+          if (!usable(p, [&] { return shape.lane_inside(batch, l); })) continue;
+          if (shape.lane_listed(batch, l)) {
+            bool listed = false;
+            auto stencil_of = [&]() -> const Stencil<Shape::stencil_size>& {
+              double bound;
+              if (!listed) shape.list_lane(batch, l, s, bound);
+              listed = true;
+              return s;
+            };
+            map(p, [&](auto&& f) { shape.for_each_lane_entry(batch, l, f); }, stencil_of,
+                shape.lane_gradient_bound(batch, l));
+          } else {
+            shape.evaluate(p, s);
+            map(p, entries_of(s), stencil_s, -1.0);
+          }
         }
-        for (int l = 0; l < count; ++l)
-          if (use[l]) map(p0 + std::size_t(l), s[l], gradient_bound[l]);
       }
 #pragma omp barrier
     } else {
-      Stencil<Shape::stencil_size> s;
 #pragma omp for schedule(static)
       for (std::size_t p = range.first; p < n; ++p) {
         if (!usable(p, [&] { return shape.inside(p); })) continue;
         shape.evaluate(p, s);
-        map(p, s, -1.0);
+        map(p, entries_of(s), stencil_s, -1.0);
       }
     }
     if constexpr (scanning) {
@@ -305,17 +317,17 @@ void grid_to_particles(const Shape& shape, const GridFields& g, Particles& P, do
   const std::size_t n = range.end(P);
 #pragma omp parallel
   {
-    auto update = [&](std::size_t p, const Stencil<Shape::stencil_size>& s) {
+    // `entries(f)` passes each entry of the particle's stencil to f.
+    auto update = [&](std::size_t p, auto&& entries) {
       Vec2 acceleration = Vec2::Zero(), velocity = Vec2::Zero();
       Mat2 L = Mat2::Zero();  // the velocity gradient, for F and for APIC's C_p
       double hoop_rate = 0.0;
-      for (int k = 0; k < s.count; ++k) {
-        const int i = s.node[k];
-        if constexpr (with_velocity && !with_affine) acceleration += s.weight[k] * g.acceleration[i];
-        if constexpr (with_position || with_affine) velocity += s.weight[k] * g.velocity[i];
-        if constexpr (with_deformation || with_affine) L += g.velocity[i] * s.gradient[k].transpose();
-        if constexpr (with_deformation && axisymmetric) hoop_rate += s.hoop[k] * g.velocity[i].x();
-      }
+      entries([&](int i, double w, const Vec2& gradient, const double& hoop = 0.0) {
+        if constexpr (with_velocity && !with_affine) acceleration += w * g.acceleration[i];
+        if constexpr (with_position || with_affine) velocity += w * g.velocity[i];
+        if constexpr (with_deformation || with_affine) L += g.velocity[i] * gradient.transpose();
+        if constexpr (with_deformation && axisymmetric) hoop_rate += hoop * g.velocity[i].x();
+      });
       if constexpr (with_deformation) {
         P.deformation_gradient[p] = (Mat2::Identity() + dt * L) * P.deformation_gradient[p];
         double J = determinant(P.deformation_gradient[p]);
@@ -333,23 +345,28 @@ void grid_to_particles(const Shape& shape, const GridFields& g, Particles& P, do
       }
       if constexpr (with_position) position_out[p] = P.position[p] + dt * velocity;
     };
+    Stencil<Shape::stencil_size> s;
     if constexpr (evaluates_lanes<Shape>()) {
       const auto [first, last] = static_block(range.first, n);
       typename Shape::LaneBatch batch;
-      Stencil<Shape::stencil_size> s[kLanes];
       for (std::size_t p0 = first; p0 < last; p0 += kLanes) {
         const int count = int(std::min<std::size_t>(kLanes, last - p0));
         shape.compute_lanes(p0, count, batch, false);
-        double gradient_bound;  // the scan's, not needed here
-        for (int l = 0; l < count; ++l) shape.list_lane(batch, l, s[l], gradient_bound);
-        for (int l = 0; l < count; ++l) update(p0 + std::size_t(l), s[l]);
+        for (int l = 0; l < count; ++l) {
+          const std::size_t p = p0 + std::size_t(l);
+          if (shape.lane_listed(batch, l)) {
+            update(p, [&](auto&& f) { shape.for_each_lane_entry(batch, l, f); });
+          } else {
+            shape.evaluate(p, s);
+            update(p, entries_of(s));
+          }
+        }
       }
     } else {
-      Stencil<Shape::stencil_size> s;
 #pragma omp for schedule(static)
       for (std::size_t p = range.first; p < n; ++p) {
         shape.evaluate(p, s);
-        update(p, s);
+        update(p, entries_of(s));
       }
     }
   }
@@ -693,18 +710,18 @@ double stiffening(const Stencil<N>& s, double h) {
 // Particle p's term, given the largest so far: k_p needs the particle's
 // stencil, which is costly, and merging its repeated nodes, so it is formed
 // only where the particle could set a new largest speed (the bounds below are
-// exact-safe: the maximum is what forming every k_p gives). `stencil` is the
-// particle's stencil when the caller has evaluated it at the same state
-// (ScanInMap), else null.
+// exact-safe: the maximum is what forming every k_p gives). `stencil_of()`
+// gives the particle's stencil where the caller has it at the same state
+// (ScanInMap; asked for only where the bounds do not settle k_p), else null.
 //
 // Most particles cannot set a new largest: a bound of their speed without the
 // material's logarithm and square roots (its wave_modulus_bound) rules them
 // out first. The margin of 1e-9 covers the round-off of the exact terms, so a
 // particle left out is one whose speed could not have changed the maximum.
-template <class Shape, class Material>
+template <class Shape, class Material, class StencilOf = std::nullptr_t>
 double signal_speed(const Shape& shape, const Material& material, const Particles& P, double h, std::size_t p,
-                    double largest, const Stencil<Shape::stencil_size>* stencil = nullptr,
-                    double stencil_gradient_bound = -1.0) {
+                    double largest, StencilOf stencil_of = nullptr, double stencil_gradient_bound = -1.0) {
+  constexpr bool with_stencil = !std::is_null_pointer_v<StencilOf>;
   const double density = P.mass[p] / P.volume[p];
   const double F33 = out_of_plane_stretch<Shape::geometry>(P, p);
   const double v = P.velocity[p].norm();
@@ -717,9 +734,9 @@ double signal_speed(const Shape& shape, const Material& material, const Particle
   [[maybe_unused]] double most = 1.0;
   [[maybe_unused]] bool most_exact = true;
   if constexpr (Shape::gradients_beyond_grid_basis) {
-    if (stencil) {
+    if constexpr (with_stencil) {
       const double bound =
-          stencil_gradient_bound >= 0.0 ? stencil_gradient_bound : entry_gradient_sum_bound(*stencil);
+          stencil_gradient_bound >= 0.0 ? stencil_gradient_bound : entry_gradient_sum_bound(stencil_of());
       // h bound / (2 + sqrt 2), lifted past what its rounding could take off:
       // where it is 1, k_p's own bound, no larger, is 1 too.
       constexpr double inverse = 1.0 / kGridBasisGradientBound;
@@ -738,8 +755,8 @@ double signal_speed(const Shape& shape, const Material& material, const Particle
       if (modulus <= density * room * room) return 0.0;
     }
   }
-  if constexpr (Shape::gradients_beyond_grid_basis)
-    if (!most_exact) most = std::max(1.0, h * entry_gradient_sum(*stencil) / kGridBasisGradientBound);
+  if constexpr (Shape::gradients_beyond_grid_basis && with_stencil)
+    if (!most_exact) most = std::max(1.0, h * entry_gradient_sum(stencil_of()) / kGridBasisGradientBound);
   const double c = std::sqrt(material.wave_modulus(P.deformation_gradient[p], F33, P.stress[p]) / density);
   double speed = c;
   // The total Lagrangian formulation: a wave crosses the current image of a
@@ -748,9 +765,9 @@ double signal_speed(const Shape& shape, const Material& material, const Particle
   if constexpr (Shape::gradients_beyond_grid_basis) {
     const double c_small = std::sqrt(material.p_wave_modulus() / density);
     if (std::max(c, most * c_small) + v > largest) {
-      const double k = !stencil                                  ? stiffening(shape, p, h)
-                       : stencil->count < Shape::stencil_size ? most
-                                                                 : stiffening(*stencil, h);
+      double k = most;
+      if constexpr (!with_stencil) k = stiffening(shape, p, h);
+      else if (stencil_of().count == Shape::stencil_size) k = stiffening(stencil_of(), h);
       if (k > 1.0) speed = std::max(c, k * c_small);
     }
   }
@@ -793,11 +810,11 @@ struct ScanInMap {
   bool healthy(std::size_t p, Inside inside) const {
     return particle_healthy(shape, P, p, inside);
   }
-  // `gradient_bound`: the stencil's entry_gradient_sum_bound where the
-  // caller has it, else negative.
-  double speed(std::size_t p, const Stencil<Shape::stencil_size>& s, double largest,
-               double gradient_bound = -1.0) const {
-    return signal_speed(shape, material, P, h, p, largest, &s, gradient_bound);
+  // `stencil_of()` gives the particle's stencil; `gradient_bound` is its
+  // entry_gradient_sum_bound where the caller has it, else negative.
+  template <class StencilOf>
+  double speed(std::size_t p, StencilOf stencil_of, double largest, double gradient_bound = -1.0) const {
+    return signal_speed(shape, material, P, h, p, largest, stencil_of, gradient_bound);
   }
 };
 

@@ -332,28 +332,56 @@ struct CpdiShapeT {
     return inside_walls(*grid, position[batch.first + std::size_t(l)]) && batch.out.box_inside[l] != 0;
   }
 
+  // True where lane l's stencil is the kernel's; a lane whose corners span
+  // more than 2 x 2 cells is left to evaluate.
+  bool lane_listed(const LaneBatch& batch, int l) const
+    requires lanes
+  {
+    return batch.out.span_i[l] <= 1 && batch.out.span_j[l] <= 1;
+  }
+
+  // Lane l's entries as evaluate lists them (the lane listed), each passed
+  // to f(node, S_gp, G_gp) in turn without a stencil between: a stencil
+  // written and read back at once stalls on its stores.
+  template <class F>
+  void for_each_lane_entry(const LaneBatch& batch, int l, F&& f) const
+    requires lanes
+  {
+    const CpdiLaneStencils& out = batch.out;
+    const int first = grid->node(out.i0[l], out.j0[l]), row = grid->nodes_x();
+    for (int b = 0; b <= out.span_j[l] + 1; ++b)
+      for (int a = 0; a <= out.span_i[l] + 1; ++a) {
+        const int slot = a + 3 * b;
+        f(first + a + b * row, out.weight[slot][l], Vec2(out.gradient_x[slot][l], out.gradient_y[slot][l]));
+      }
+  }
+
+  // The bound of sum_g |G_gp| the kernel gives with lane l's entries.
+  double lane_gradient_bound(const LaneBatch& batch, int l) const
+    requires lanes
+  {
+    return batch.out.gradient_bound[l];
+  }
+
+  // Lane l's stencil as evaluate gives it, with an upper bound of its
+  // sum_g |G_gp| (the time-step scan's; stages.hpp: signal_speed).
   void list_lane(const LaneBatch& batch, int l, Stencil<stencil_size>& st, double& gradient_bound) const
     requires lanes
   {
-    const GridGeometry& g = *grid;
-    const CpdiLaneStencils& out = batch.out;
-    const int span_i = out.span_i[l], span_j = out.span_j[l];
-    if (span_i > 1 || span_j > 1) {
+    if (!lane_listed(batch, l)) {
       evaluate(batch.first + std::size_t(l), st);
       gradient_bound = entry_gradient_sum_bound(st);
       return;
     }
-    gradient_bound = out.gradient_bound[l];
-    // The nodes the corners reach, as evaluate lists them.
     int n = 0;
-    for (int b = 0; b <= span_j + 1; ++b)
-      for (int a = 0; a <= span_i + 1; ++a, ++n) {
-        const int slot = a + 3 * b;
-        st.node[n] = g.node(out.i0[l] + a, out.j0[l] + b);
-        st.weight[n] = out.weight[slot][l];
-        st.gradient[n] = Vec2(out.gradient_x[slot][l], out.gradient_y[slot][l]);
-      }
+    for_each_lane_entry(batch, l, [&](int node, double w, const Vec2& gradient) {
+      st.node[n] = node;
+      st.weight[n] = w;
+      st.gradient[n] = gradient;
+      ++n;
+    });
     st.count = n;
+    gradient_bound = lane_gradient_bound(batch, l);
   }
 
   // A corner domain turned over, 4 det [a_1 a_2] <= 0 (monitors.hpp:

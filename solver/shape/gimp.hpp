@@ -167,20 +167,46 @@ struct GimpShapeT {
     return inside(batch.first + std::size_t(l));
   }
 
-  void list_lane(const LaneBatch& batch, int l, Stencil<stencil_size>& st, double& gradient_bound) const
+  // Lane l's entries as evaluate lists them, each passed to f(node, S_gp,
+  // G_gp) in turn (as for CPDI, cpdi.hpp: for_each_lane_entry).
+  bool lane_listed(const LaneBatch&, int) const
+    requires lanes
+  {
+    return true;
+  }
+
+  template <class F>
+  void for_each_lane_entry(const LaneBatch& batch, int l, F&& f) const
     requires lanes
   {
     const GridGeometry& g = *grid;
     const GimpLaneStencils& out = batch.out;
-    gradient_bound = -1.0;
-    int k = 0;
     for (int b = 0; b < 3; ++b)
-      for (int a = 0; a < 3; ++a, ++k) {
-        st.node[k] = g.node(out.node_i[a][l], out.node_j[b][l]);
-        st.weight[k] = out.weight[k][l];
-        st.gradient[k] = Vec2(out.gradient_x[k][l], out.gradient_y[k][l]);
+      for (int a = 0; a < 3; ++a) {
+        const int slot = a + 3 * b;
+        f(g.node(out.node_i[a][l], out.node_j[b][l]), out.weight[slot][l],
+          Vec2(out.gradient_x[slot][l], out.gradient_y[slot][l]));
       }
-    st.count = stencil_size;
+  }
+
+  double lane_gradient_bound(const LaneBatch&, int) const
+    requires lanes
+  {
+    return -1.0;
+  }
+
+  void list_lane(const LaneBatch& batch, int l, Stencil<stencil_size>& st, double& gradient_bound) const
+    requires lanes
+  {
+    int n = 0;
+    for_each_lane_entry(batch, l, [&](int node, double w, const Vec2& gradient) {
+      st.node[n] = node;
+      st.weight[n] = w;
+      st.gradient[n] = gradient;
+      ++n;
+    });
+    st.count = n;
+    gradient_bound = lane_gradient_bound(batch, l);
   }
 
   // The particle's centre lies between the walls and its domain inside the

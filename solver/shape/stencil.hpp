@@ -30,6 +30,16 @@ struct Stencil {
   double hoop[N];
 };
 
+// A stencil's entries as a stage takes them: entries_of(s)(f) passes each
+// to f(node, S_gp, G_gp, <S_g / r>_p) in turn (the lane kernels' batches pass
+// theirs the same way, without a stencil: cpdi.hpp, for_each_lane_entry).
+template <int N>
+auto entries_of(const Stencil<N>& s) {
+  return [&s](auto&& f) {
+    for (int k = 0; k < s.count; ++k) f(s.node[k], s.weight[k], s.gradient[k], s.hoop[k]);
+  };
+}
+
 // An upper bound of sum_k |G_k| over a stencil's entries as listed, without
 // a square root, entry by entry
 //   |G| <= max(|G_x|, |G_y|) + (sqrt 2 - 1) min(|G_x|, |G_y|)
