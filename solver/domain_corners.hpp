@@ -26,13 +26,10 @@
 #include "grid.hpp"
 #include "particles.hpp"
 #include "shape/linear.hpp"
+#include "shape/lane_shared.hpp"  // kCornerXi, kCornerEta
 #include "tensor.hpp"
 
 namespace mpmvv {
-
-// Natural coordinates of the corners, counter-clockwise from (-1, -1).
-inline constexpr double kCornerXi[4] = {-1.0, 1.0, 1.0, -1.0};
-inline constexpr double kCornerEta[4] = {-1.0, -1.0, 1.0, 1.0};
 
 // The bilinear map of a quadrilateral, x = a_0 + a_1 xi + a_2 eta + a_3 xi eta:
 // its linear part at the centre as the columns [a_1 a_2], the half-vectors a

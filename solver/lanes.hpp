@@ -1,20 +1,27 @@
 // Particle loops in lanes: a stencil kernel (shape/cpdi_lanes.hpp,
 // shape/gimp_lanes.hpp) computes eight particles at once, each in a lane of
 // one vector, and is compiled three times, for the baseline x86-64 (SSE2),
-// for AVX2 and for AVX-512. The widest build the CPU has is chosen once, when
-// the program starts; every build gives the same bits as the scalar code,
-// since no build fuses a multiply with an add (solver/CMakeLists.txt) and
-// each repeats the scalar code's operations in its order.
+// for AVX2 and for AVX-512 (solver/CMakeLists.txt: each build its own
+// compilation of the kernel, so that every vector operation is lowered for
+// the instructions it runs on). The widest build the CPU has is chosen once,
+// when it is first asked for; every build gives the same bits as the scalar
+// code, since no build fuses a multiply with an add and each repeats the
+// scalar code's operations in its order.
 #pragma once
 
 namespace mpmvv {
 
 inline constexpr int kLanes = 8;
 
-enum class LaneBuild { baseline, avx2, avx512f };
+enum class LaneBuild { baseline, avx2, avx512 };  // avx512: its F, DQ and VL extensions
 
 bool cpu_has(LaneBuild build);
+// The widest build the CPU has, or the one the environment's
+// MPMVV_LANE_BUILD names (avx512, avx2 or baseline) where the CPU has it:
+// for benchmarks that compare the builds on one machine.
 LaneBuild widest_lane_build();
+// The build the kernels run: widest_lane_build(), chosen once.
+LaneBuild lane_build();
 const char* name(LaneBuild build);
 
 }  // namespace mpmvv

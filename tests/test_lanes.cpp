@@ -109,7 +109,7 @@ void expect_lanes_equal_evaluate(const Shape& shape, std::size_t n, LaneBuild bu
 
 std::vector<LaneBuild> builds_of_this_cpu() {
   std::vector<LaneBuild> builds;
-  for (LaneBuild b : {LaneBuild::baseline, LaneBuild::avx2, LaneBuild::avx512f})
+  for (LaneBuild b : {LaneBuild::baseline, LaneBuild::avx2, LaneBuild::avx512})
     if (mpmvv::cpu_has(b)) builds.push_back(b);
   return builds;
 }

@@ -2,19 +2,14 @@
 // Each line is the scalar line of CpdiShapeT::evaluate it repeats.
 #include "cpdi_lanes.hpp"
 
-#include "../domain_corners.hpp"  // kCornerXi, kCornerEta
 #include "../lane_vectors.hpp"
-#include "stencil.hpp"  // kOctagonFactor
+#include "lane_shared.hpp"  // kCornerXi, kCornerEta, kOctagonFactor
 
 namespace mpmvv {
 
 namespace {
 
-using lanes::lane_max;
-using lanes::lane_min;
-using lanes::load;
-using lanes::store;
-using lanes::Width;
+using namespace lanes::MPMVV_LANE_BUILD_NS;
 
 struct CpdiKernel {
   using Grid = CpdiLaneGrid;
@@ -113,12 +108,26 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
 
 }  // namespace
 
+namespace lanes::MPMVV_LANE_BUILD_NS {
 void cpdi_lane_stencils(const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiLaneStencils& out) {
-  lanes::run_lanes<CpdiKernel>(lanes::widest, grid, in, out);
+  run<CpdiKernel>(grid, in, out);
+}
+}  // namespace lanes::MPMVV_LANE_BUILD_NS
+
+#if defined(MPMVV_LANE_DISPATCH)
+void cpdi_lane_stencils(LaneBuild build, const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiLaneStencils& out) {
+  switch (build) {
+#if defined(MPMVV_LANES_X86)
+    case LaneBuild::avx512: lanes::avx512::cpdi_lane_stencils(grid, in, out); return;
+    case LaneBuild::avx2: lanes::avx2::cpdi_lane_stencils(grid, in, out); return;
+#endif
+    default: lanes::baseline::cpdi_lane_stencils(grid, in, out); return;
+  }
 }
 
-void cpdi_lane_stencils(LaneBuild build, const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiLaneStencils& out) {
-  lanes::run_lanes<CpdiKernel>(build, grid, in, out);
+void cpdi_lane_stencils(const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiLaneStencils& out) {
+  cpdi_lane_stencils(lane_build(), grid, in, out);
 }
+#endif
 
 }  // namespace mpmvv

@@ -64,8 +64,20 @@ struct CpdiLaneStencils {
   alignas(32) int span_j[kLanes];
 };
 
+// With the build the kernels run (lane_build), or with a given one, which
+// the CPU must have (cpu_has).
 void cpdi_lane_stencils(const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiLaneStencils& out);
-// The same with a given build, which the CPU must have (cpu_has).
 void cpdi_lane_stencils(LaneBuild build, const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiLaneStencils& out);
+
+// Each build's own, compiled for its instructions (solver/CMakeLists.txt).
+namespace lanes::avx512 {
+void cpdi_lane_stencils(const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiLaneStencils& out);
+}
+namespace lanes::avx2 {
+void cpdi_lane_stencils(const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiLaneStencils& out);
+}
+namespace lanes::baseline {
+void cpdi_lane_stencils(const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiLaneStencils& out);
+}
 
 }  // namespace mpmvv

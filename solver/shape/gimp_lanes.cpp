@@ -8,11 +8,7 @@ namespace mpmvv {
 
 namespace {
 
-using lanes::lane_max;
-using lanes::lane_min;
-using lanes::load;
-using lanes::store;
-using lanes::Width;
+using namespace lanes::MPMVV_LANE_BUILD_NS;
 
 // gimp_weight_1d of each lane: the last piece first, then each earlier piece
 // where its test holds, so that the first test that holds decides, as in
@@ -94,12 +90,26 @@ void GimpKernel::body(const GimpLaneGrid& g, const GimpLaneInput& in, GimpLaneSt
 
 }  // namespace
 
+namespace lanes::MPMVV_LANE_BUILD_NS {
 void gimp_lane_stencils(const GimpLaneGrid& grid, const GimpLaneInput& in, GimpLaneStencils& out) {
-  lanes::run_lanes<GimpKernel>(lanes::widest, grid, in, out);
+  run<GimpKernel>(grid, in, out);
+}
+}  // namespace lanes::MPMVV_LANE_BUILD_NS
+
+#if defined(MPMVV_LANE_DISPATCH)
+void gimp_lane_stencils(LaneBuild build, const GimpLaneGrid& grid, const GimpLaneInput& in, GimpLaneStencils& out) {
+  switch (build) {
+#if defined(MPMVV_LANES_X86)
+    case LaneBuild::avx512: lanes::avx512::gimp_lane_stencils(grid, in, out); return;
+    case LaneBuild::avx2: lanes::avx2::gimp_lane_stencils(grid, in, out); return;
+#endif
+    default: lanes::baseline::gimp_lane_stencils(grid, in, out); return;
+  }
 }
 
-void gimp_lane_stencils(LaneBuild build, const GimpLaneGrid& grid, const GimpLaneInput& in, GimpLaneStencils& out) {
-  lanes::run_lanes<GimpKernel>(build, grid, in, out);
+void gimp_lane_stencils(const GimpLaneGrid& grid, const GimpLaneInput& in, GimpLaneStencils& out) {
+  gimp_lane_stencils(lane_build(), grid, in, out);
 }
+#endif
 
 }  // namespace mpmvv

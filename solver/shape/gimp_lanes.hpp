@@ -32,8 +32,20 @@ struct GimpLaneStencils {
   alignas(32) int node_j[3][kLanes];
 };
 
+// With the build the kernels run (lane_build), or with a given one, which
+// the CPU must have (cpu_has).
 void gimp_lane_stencils(const GimpLaneGrid& grid, const GimpLaneInput& in, GimpLaneStencils& out);
-// The same with a given build, which the CPU must have (cpu_has).
 void gimp_lane_stencils(LaneBuild build, const GimpLaneGrid& grid, const GimpLaneInput& in, GimpLaneStencils& out);
+
+// Each build's own, compiled for its instructions (solver/CMakeLists.txt).
+namespace lanes::avx512 {
+void gimp_lane_stencils(const GimpLaneGrid& grid, const GimpLaneInput& in, GimpLaneStencils& out);
+}
+namespace lanes::avx2 {
+void gimp_lane_stencils(const GimpLaneGrid& grid, const GimpLaneInput& in, GimpLaneStencils& out);
+}
+namespace lanes::baseline {
+void gimp_lane_stencils(const GimpLaneGrid& grid, const GimpLaneInput& in, GimpLaneStencils& out);
+}
 
 }  // namespace mpmvv

@@ -10,6 +10,7 @@
 #include "../geometry.hpp"
 #include "../grid.hpp"
 #include "../tensor.hpp"
+#include "lane_shared.hpp"
 
 namespace mpmvv {
 
@@ -46,8 +47,7 @@ auto entries_of(const Stencil<N>& s) {
 // (the chord of the convex sqrt(1 + t^2) over t in [0, 1], equal at its
 // ends): the time-step scan (stages.hpp: signal_speed) runs it for every
 // particle every step, where nine square roots in a row cost more than the
-// rest of the particle's test.
-inline constexpr double kOctagonFactor = 0.41421356237309515;  // sqrt 2 - 1, rounded up
+// rest of the particle's test. kOctagonFactor: lane_shared.hpp.
 
 template <int N>
 double entry_gradient_sum_bound(const Stencil<N>& s) {

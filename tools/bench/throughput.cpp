@@ -44,7 +44,7 @@ int main(int argc, char** argv) {
   fmt::print("ns: wall time per particle-step, then the same for each stage (stage_times.hpp; other: the time loop, "
              "output, ledgers);\nbytes: what the particles and the stepper hold per particle; CPDI stencils by the {} "
              "build of the lane kernel (solver/shape/cpdi_lanes.hpp)\n",
-             mpmvv::name(mpmvv::widest_lane_build()));
+             mpmvv::name(mpmvv::lane_build()));
   fmt::print("{:>10} {:>7} {:>9} {:>6} {:>16} {:>7} | {:>6} {:>6} {:>6} {:>6} {:>6} {:>7} {:>6} | {:>5}\n", "method",
              "threads", "particles", "steps", "particle-steps/s", "ns", "map", "grid", "update", "stress", "scan",
              "forcing", "other", "bytes");
