@@ -613,10 +613,14 @@ bool particle_healthy(const Shape& shape, const Particles& P, std::size_t p, Ins
   const double J = determinant(P.deformation_gradient[p]) * F33;
   // 0 x is +-0 for a finite x and NaN for an infinite or NaN one: the sum of
   // the products is zero exactly when every entry is finite, with no branch
-  // per entry (the test runs for every particle every step).
-  double zero = 0.0 * (P.position[p].x()) + 0.0 * (P.position[p].y()) + 0.0 * (P.velocity[p].x()) +
-                0.0 * (P.velocity[p].y());
-  for (int k = 0; k < 4; ++k) zero += 0.0 * P.deformation_gradient[p](k) + 0.0 * P.stress[p](k);
+  // per entry (the test runs for every particle every step). Summed as a
+  // tree of pairs, not a chain: twelve additions in a row each wait for the
+  // last.
+  const Mat2& F = P.deformation_gradient[p];
+  const Mat2& stress = P.stress[p];
+  const Vec2 pairs = (0.0 * P.position[p] + 0.0 * P.velocity[p]) +
+                     ((0.0 * F.col(0) + 0.0 * stress.col(0)) + (0.0 * F.col(1) + 0.0 * stress.col(1)));
+  double zero = pairs.x() + pairs.y();
   if constexpr (Shape::geometry == Geometry::axisymmetric) zero += 0.0 * P.hoop_stress[p];
   if (!(zero == 0.0 && J > 0.0)) return false;
   if constexpr (std::is_same_v<Inside, std::nullptr_t>) return shape.inside(p);
