@@ -637,16 +637,26 @@ double entry_gradient_sum(const Stencil<N>& s);
 template <int N>
 double gradient_sum(const Stencil<N>& s) {
   if (s.count < N) return entry_gradient_sum(s);
-  double sum = 0.0;
+  // The nodes in the order they first appear, each with its entries' sum in
+  // the order they are listed; then the lengths, computed apart from the
+  // sum so that their square roots do not wait on one another.
+  int node[N];
+  Vec2 g[N];
+  int nodes = 0;
   for (int k = 0; k < s.count; ++k) {
-    bool first = true;
-    for (int j = 0; j < k && first; ++j) first = s.node[j] != s.node[k];
-    if (!first) continue;
-    Vec2 g = s.gradient[k];
-    for (int j = k + 1; j < s.count; ++j)
-      if (s.node[j] == s.node[k]) g += s.gradient[j];
-    sum += g.norm();
+    int j = 0;
+    while (j < nodes && node[j] != s.node[k]) ++j;
+    if (j == nodes) {
+      node[nodes] = s.node[k];
+      g[nodes++] = s.gradient[k];
+    } else {
+      g[j] += s.gradient[k];
+    }
   }
+  double length[N];
+  for (int j = 0; j < nodes; ++j) length[j] = g[j].norm();
+  double sum = 0.0;
+  for (int j = 0; j < nodes; ++j) sum += length[j];
   return sum;
 }
 
@@ -759,8 +769,18 @@ double signal_speed(const Shape& shape, const Material& material, const Particle
       if (modulus <= density * room * room) return 0.0;
     }
   }
-  if constexpr (Shape::gradients_beyond_grid_basis && with_stencil)
-    if (!most_exact) most = std::max(1.0, h * entry_gradient_sum(stencil_of()) / kGridBasisGradientBound);
+  // Past the test, with the stencil at hand, k_p itself: the sum over
+  // entries where no node repeats, else the sum over nodes (stiffening).
+  // Either is at most the bound above, so a particle the next test leaves
+  // out could not have set the maximum with it.
+  if constexpr (Shape::gradients_beyond_grid_basis && with_stencil) {
+    if (!most_exact) {
+      const auto& stencil = stencil_of();
+      most = stencil.count == Shape::stencil_size
+                 ? stiffening(stencil, h)
+                 : std::max(1.0, h * entry_gradient_sum(stencil) / kGridBasisGradientBound);
+    }
+  }
   const double c = std::sqrt(material.wave_modulus(P.deformation_gradient[p], F33, P.stress[p]) / density);
   double speed = c;
   // The total Lagrangian formulation: a wave crosses the current image of a
@@ -771,7 +791,6 @@ double signal_speed(const Shape& shape, const Material& material, const Particle
     if (std::max(c, most * c_small) + v > largest) {
       double k = most;
       if constexpr (!with_stencil) k = stiffening(shape, p, h);
-      else if (stencil_of().count == Shape::stencil_size) k = stiffening(stencil_of(), h);
       if (k > 1.0) speed = std::max(c, k * c_small);
     }
   }
