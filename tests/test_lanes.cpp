@@ -9,6 +9,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <random>
 #include <vector>
 
@@ -171,3 +172,20 @@ TEST(GimpLanes, EveryBuildGivesTheScalarStencilsBitForBit) {
 }
 
 }  // namespace
+
+// MPMVV_LANE_BUILD names the build a benchmark runs, where the CPU has it;
+// any other value leaves the widest.
+TEST(LaneBuilds, TheEnvironmentNamesABuildTheCpuHas) {
+  ::unsetenv("MPMVV_LANE_BUILD");
+  const LaneBuild widest = mpmvv::widest_lane_build();
+  EXPECT_TRUE(mpmvv::cpu_has(widest));
+  ::setenv("MPMVV_LANE_BUILD", "baseline", 1);
+  EXPECT_EQ(mpmvv::widest_lane_build(), LaneBuild::baseline);
+  for (LaneBuild b : builds_of_this_cpu()) {
+    ::setenv("MPMVV_LANE_BUILD", mpmvv::name(b), 1);
+    EXPECT_EQ(mpmvv::widest_lane_build(), b) << mpmvv::name(b);
+  }
+  ::setenv("MPMVV_LANE_BUILD", "sse5", 1);
+  EXPECT_EQ(mpmvv::widest_lane_build(), widest);
+  ::unsetenv("MPMVV_LANE_BUILD");
+}

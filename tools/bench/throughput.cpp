@@ -41,9 +41,9 @@ int main(int argc, char** argv) {
   fmt::print("ring scene (its defaults: A = 0.5, 2 particles per cell per direction; centre seeding), {} cells, {} to t = {} s{}, best of "
              "{}\n",
              cells, scheme, end_time, extra.empty() ? "" : ", " + fmt::format("{}", fmt::join(extra, ", ")), repeats);
-  fmt::print("ns: wall time per particle-step, then the same for each stage (stage_times.hpp; other: the time loop, "
-             "output, ledgers);\nbytes: what the particles and the stepper hold per particle; CPDI stencils by the {} "
-             "build of the lane kernel (solver/shape/cpdi_lanes.hpp)\n",
+  fmt::print("ns: wall time per particle-step, then the same for each stage (stage_times.hpp; other: set-up, the "
+             "time loop, output, ledgers);\nbytes: what the particles and the stepper hold per particle; CPDI and uGIMP "
+             "stencils by the {} build of the lane kernels (solver/lanes.hpp; MPMVV_LANE_BUILD names another)\n",
              mpmvv::name(mpmvv::lane_build()));
   fmt::print("{:>10} {:>7} {:>9} {:>6} {:>16} {:>7} | {:>6} {:>6} {:>6} {:>6} {:>6} {:>7} {:>6} | {:>5}\n", "method",
              "threads", "particles", "steps", "particle-steps/s", "ns", "map", "grid", "update", "stress", "scan",
