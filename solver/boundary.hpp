@@ -14,6 +14,7 @@
 #include "contact.hpp"
 #include "grid.hpp"
 #include "model.hpp"
+#include "parallel.hpp"
 #include "particles.hpp"
 
 namespace mpmvv {
@@ -127,17 +128,22 @@ inline void damp_grid_motion(GridFields& g, double zeta, double kick) {
 // walls only mirror the nodes inside.
 inline double damping_power(const GridGeometry& grid, const GridFields& g, double zeta,
                             const std::vector<unsigned char>& fixed) {
-  double power = 0.0;
   const int nx = grid.nodes_x(), ny = grid.nodes_y(), ghost = grid.ghost_layers;
-#pragma omp parallel for schedule(static) reduction(+ : power)
-  for (int j = ghost; j < ny - ghost; ++j)
-    for (int i = ghost; i < nx - ghost; ++i) {
-      const std::size_t node = std::size_t(grid.node(i, j));
-      if (!(g.mass[node] > 0.0)) continue;
-      for (int a = 0; a < 2; ++a)
-        if (!fixed[2 * node + std::size_t(a)]) power -= zeta * g.momentum[node][a] * g.velocity[node][a];
-    }
-  return power;
+  ThreadOrderedSums<1> power;
+#pragma omp parallel
+  {
+    double own = 0.0;
+#pragma omp for schedule(static)
+    for (int j = ghost; j < ny - ghost; ++j)
+      for (int i = ghost; i < nx - ghost; ++i) {
+        const std::size_t node = std::size_t(grid.node(i, j));
+        if (!(g.mass[node] > 0.0)) continue;
+        for (int a = 0; a < 2; ++a)
+          if (!fixed[2 * node + std::size_t(a)]) own -= zeta * g.momentum[node][a] * g.velocity[node][a];
+      }
+    power.keep({own});
+  }
+  return power.total()[0];
 }
 
 // ---------------------------------------------------------------- what a scene adds

@@ -604,10 +604,15 @@ class ExplicitStepper final : public Stepper {
     if (!body_force_) return;
     const Particles& P = model_.particles;
     const std::size_t n = P.size();
-    double work = 0.0;
-#pragma omp parallel for schedule(static) reduction(+ : work)
-    for (std::size_t p = 0; p < n; ++p) work += P.mass[p] * P.body_force[p].dot(P.velocity[p]);
-    ledger_.body += dt * work;
+    ThreadOrderedSums<1> work;
+#pragma omp parallel
+    {
+      double own = 0.0;
+#pragma omp for schedule(static)
+      for (std::size_t p = 0; p < n; ++p) own += P.mass[p] * P.body_force[p].dot(P.velocity[p]);
+      work.keep({own});
+    }
+    ledger_.body += dt * work.total()[0];
   }
 
   void evaluate_body_force(double t) {

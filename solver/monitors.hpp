@@ -71,44 +71,51 @@ Monitors monitor_particles(const Shape& shape, const Material& material, const P
                            const GridGeometry& grid, std::size_t begin = 0, std::size_t end = kAllParticles) {
   Monitors m;
   const std::size_t n = std::min(end, P.size());
-  double kinetic = 0.0, strain = 0.0, min_J = m.min_J, max_J = 0.0, mach = 0.0, spin = 0.0;
+  double min_J = m.min_J, max_J = 0.0, mach = 0.0;
   double distortion = 0.0, wave_ratio = 0.0, basis_stiffening = 0.0;
   std::size_t near = 0, folded = 0;
   constexpr bool has_domain = Shape::has_domain;
-#pragma omp parallel for schedule(static) reduction(+ : kinetic, strain, near, folded, spin) reduction(min : min_J) \
-    reduction(max : max_J, mach, distortion, wave_ratio, basis_stiffening)
-  for (std::size_t p = begin; p < n; ++p) {
-    const double F33 = out_of_plane_stretch<Shape::geometry>(P, p);
-    const double J = determinant(P.deformation_gradient[p]) * F33;
-    kinetic += 0.5 * P.mass[p] * P.velocity[p].squaredNorm();
-    spin += P.mass[p] * (P.position[p].x() * P.velocity[p].y() - P.position[p].y() * P.velocity[p].x());
-    strain += P.reference_volume[p] * material.energy_density(P.deformation_gradient[p], F33);
-    min_J = std::min(min_J, J);
-    max_J = std::max(max_J, J);
-    const double density = P.mass[p] / P.volume[p];
-    const double c = std::sqrt(material.wave_modulus(P.deformation_gradient[p], F33, P.stress[p]) / density);
-    mach = std::max(mach, P.velocity[p].norm() / c);
-    wave_ratio = std::max(wave_ratio, c / std::sqrt(material.p_wave_modulus() * P.reference_volume[p] / P.mass[p]));
-    double basis = 1.0;
-    if constexpr (requires { shape.cell_stretch(p); }) basis = 1.0 / std::min(1.0, shape.cell_stretch(p));
-    if constexpr (Shape::gradients_beyond_grid_basis) basis = std::max(basis, stiffening(shape, p, grid.h));
-    basis_stiffening = std::max(basis_stiffening, basis);
-    const Mat2 s = shape.domain(p);
-    if constexpr (has_domain) {
-      const double area = std::abs(determinant(s));
-      distortion = std::max(distortion, area > 0.0 ? s.squaredNorm() / (2.0 * area)
-                                                   : std::numeric_limits<double>::infinity());
-    }
-    bool edge = false;
-    for (const double a : {-1.0, 1.0})
-      for (const double b : {-1.0, 1.0}) {
-        const Vec2 xi = grid_coordinate(grid, P.position[p] + a * s.col(0) + b * s.col(1));
-        edge = edge || !(xi.x() >= 0.5 && xi.y() >= 0.5 && xi.x() <= grid.cells_x - 0.5 && xi.y() <= grid.cells_y - 0.5);
+  ThreadOrderedSums<3> sums;  // kinetic, strain, spin
+#pragma omp parallel
+  {
+    double kinetic = 0.0, strain = 0.0, spin = 0.0;
+#pragma omp for schedule(static) reduction(+ : near, folded) reduction(min : min_J) \
+      reduction(max : max_J, mach, distortion, wave_ratio, basis_stiffening)
+    for (std::size_t p = begin; p < n; ++p) {
+      const double F33 = out_of_plane_stretch<Shape::geometry>(P, p);
+      const double J = determinant(P.deformation_gradient[p]) * F33;
+      kinetic += 0.5 * P.mass[p] * P.velocity[p].squaredNorm();
+      spin += P.mass[p] * (P.position[p].x() * P.velocity[p].y() - P.position[p].y() * P.velocity[p].x());
+      strain += P.reference_volume[p] * material.energy_density(P.deformation_gradient[p], F33);
+      min_J = std::min(min_J, J);
+      max_J = std::max(max_J, J);
+      const double density = P.mass[p] / P.volume[p];
+      const double c = std::sqrt(material.wave_modulus(P.deformation_gradient[p], F33, P.stress[p]) / density);
+      mach = std::max(mach, P.velocity[p].norm() / c);
+      wave_ratio = std::max(wave_ratio, c / std::sqrt(material.p_wave_modulus() * P.reference_volume[p] / P.mass[p]));
+      double basis = 1.0;
+      if constexpr (requires { shape.cell_stretch(p); }) basis = 1.0 / std::min(1.0, shape.cell_stretch(p));
+      if constexpr (Shape::gradients_beyond_grid_basis) basis = std::max(basis, stiffening(shape, p, grid.h));
+      basis_stiffening = std::max(basis_stiffening, basis);
+      const Mat2 s = shape.domain(p);
+      if constexpr (has_domain) {
+        const double area = std::abs(determinant(s));
+        distortion = std::max(distortion, area > 0.0 ? s.squaredNorm() / (2.0 * area)
+                                                     : std::numeric_limits<double>::infinity());
       }
-    if (edge) ++near;
-    if constexpr (requires { shape.folded(p); })
-      if (shape.folded(p)) ++folded;
+      bool edge = false;
+      for (const double a : {-1.0, 1.0})
+        for (const double b : {-1.0, 1.0}) {
+          const Vec2 xi = grid_coordinate(grid, P.position[p] + a * s.col(0) + b * s.col(1));
+          edge = edge || !(xi.x() >= 0.5 && xi.y() >= 0.5 && xi.x() <= grid.cells_x - 0.5 && xi.y() <= grid.cells_y - 0.5);
+        }
+      if (edge) ++near;
+      if constexpr (requires { shape.folded(p); })
+        if (shape.folded(p)) ++folded;
+    }
+    sums.keep({kinetic, strain, spin});
   }
+  const auto [kinetic, strain, spin] = sums.total();
   m.kinetic = kinetic;
   if constexpr (Shape::geometry == Geometry::plane_strain) m.angular_momentum = spin;
   m.strain = strain;

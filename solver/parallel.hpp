@@ -1,6 +1,7 @@
 // OpenMP helpers. Without OpenMP everything runs on one thread.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <utility>
 #include <vector>
@@ -65,5 +66,34 @@ inline void sum_into_first(std::vector<std::vector<double>>& per_thread, std::si
   for (std::size_t i = 0; i < count; ++i)
     for (std::size_t t = 1; t < per_thread.size(); ++t) per_thread[0][i] += per_thread[t][i];
 }
+
+// Sums over a parallel loop with the same bits for a given thread count:
+// each thread sums its own iterations in order and keeps its K sums, and
+// total() adds the threads' sums in thread order. (An OpenMP reduction adds
+// them in the order the threads finish: the same with one or two threads, a
+// sum of two being the same either way, but with three or more the last
+// bits change from run to run.)
+//   ThreadOrderedSums<1> sums;
+//   #pragma omp parallel
+//   { double own = 0.0;
+//     #pragma omp for schedule(static)
+//     for (...) own += ...;
+//     sums.keep({own}); }
+template <std::size_t K>
+class ThreadOrderedSums {
+ public:
+  ThreadOrderedSums() : per_thread_(std::size_t(max_threads()), std::array<double, K>{}) {}
+  // Called by each thread of the region, once.
+  void keep(const std::array<double, K>& own) { per_thread_[std::size_t(thread_id())] = own; }
+  std::array<double, K> total() const {
+    std::array<double, K> sum{};
+    for (const std::array<double, K>& own : per_thread_)
+      for (std::size_t k = 0; k < K; ++k) sum[k] += own[k];
+    return sum;
+  }
+
+ private:
+  std::vector<std::array<double, K>> per_thread_;
+};
 
 }  // namespace mpmvv

@@ -530,26 +530,32 @@ ViscousStep add_bulk_viscosity(const Shape& shape, Particles& P, const std::vect
   constexpr Geometry G = Shape::geometry;
   constexpr bool has_domain = Shape::has_domain;
   const std::size_t n = std::min(end, P.size());
-  double dissipated = 0.0, max_ratio = 0.0;
-#pragma omp parallel for schedule(static) reduction(+ : dissipated) reduction(max : max_ratio)
-  for (std::size_t p = begin; p < n; ++p) {
-    const double rate = std::log(P.volume[p] / volume_before[p]) / dt;
-    if (!std::isfinite(rate)) continue;  // the health scan reports the particle
-    double l = h;
-    if constexpr (has_domain) {  // the method's domain, half-vectors r1, r2: area over longest side
-      const Mat2 s = shape.domain(p);
-      l = std::min(h, 2.0 * std::abs(determinant(s)) / std::max(s.col(0).norm(), s.col(1).norm()));
+  double max_ratio = 0.0;
+  ThreadOrderedSums<1> dissipated;
+#pragma omp parallel
+  {
+    double own = 0.0;
+#pragma omp for schedule(static) reduction(max : max_ratio)
+    for (std::size_t p = begin; p < n; ++p) {
+      const double rate = std::log(P.volume[p] / volume_before[p]) / dt;
+      if (!std::isfinite(rate)) continue;  // the health scan reports the particle
+      double l = h;
+      if constexpr (has_domain) {  // the method's domain, half-vectors r1, r2: area over longest side
+        const Mat2 s = shape.domain(p);
+        l = std::min(h, 2.0 * std::abs(determinant(s)) / std::max(s.col(0).norm(), s.col(1).norm()));
+      }
+      const double density = P.mass[p] / P.volume[p];
+      const double c = std::sqrt(wave_modulus / density);
+      const double q = -density * l * (c0 * c + c1 * l * std::abs(rate)) * rate;
+      P.stress[p](0, 0) -= q;
+      P.stress[p](1, 1) -= q;
+      if constexpr (G == Geometry::axisymmetric) P.hoop_stress[p] -= q;
+      own += -q * rate * P.volume[p] * dt;
+      max_ratio = std::max(max_ratio, c0 + c1 * l * std::abs(rate) / c);
     }
-    const double density = P.mass[p] / P.volume[p];
-    const double c = std::sqrt(wave_modulus / density);
-    const double q = -density * l * (c0 * c + c1 * l * std::abs(rate)) * rate;
-    P.stress[p](0, 0) -= q;
-    P.stress[p](1, 1) -= q;
-    if constexpr (G == Geometry::axisymmetric) P.hoop_stress[p] -= q;
-    dissipated += -q * rate * P.volume[p] * dt;
-    max_ratio = std::max(max_ratio, c0 + c1 * l * std::abs(rate) / c);
+    dissipated.keep({own});
   }
-  return {dissipated, max_ratio};
+  return {dissipated.total()[0], max_ratio};
 }
 
 // ---------------------------------------------------------------- tracers

@@ -1071,6 +1071,47 @@ TEST(Threads, RunsAreRepeatable) {
   EXPECT_LT(largest, 1e-12);
 }
 
+// Sums over a parallel loop (energies, work ledgers, error norms) come out
+// with the same bits whichever thread finishes first: with four threads the
+// threads' sums are added in thread order, the sum a serial loop over the
+// same static blocks gives. Terms of many magnitudes make any other order
+// show in the last bits.
+TEST(Threads, SumsAreAddedInThreadOrder) {
+  const int default_threads = mpmvv::max_threads();
+  mpmvv::set_threads(4);
+  const bool four_threads = mpmvv::max_threads() == 4;
+  if (!four_threads) {
+    mpmvv::set_threads(default_threads);
+    GTEST_SKIP() << "built without OpenMP";
+  }
+  const std::size_t n = 4003;
+  std::vector<double> term(n);
+  for (std::size_t p = 0; p < n; ++p) term[p] = std::pow(10.0, double(p % 17) - 8.0) * (1.0 + 1e-3 * double(p));
+  auto parallel_sum = [&] {
+    mpmvv::ThreadOrderedSums<1> sums;
+#pragma omp parallel num_threads(4)
+    {
+      double own = 0.0;
+#pragma omp for schedule(static)
+      for (std::size_t p = 0; p < n; ++p) own += term[p];
+      sums.keep({own});
+    }
+    return sums.total()[0];
+  };
+  // libgomp's static split: the first n % 4 threads take one more.
+  double expected = 0.0;
+  std::size_t first = 0;
+  for (std::size_t t = 0; t < 4; ++t) {
+    const std::size_t count = n / 4 + (t < n % 4 ? 1 : 0);
+    double own = 0.0;
+    for (std::size_t p = first; p < first + count; ++p) own += term[p];
+    expected += own;
+    first += count;
+  }
+  for (int repeat = 0; repeat < 200; ++repeat) ASSERT_EQ(parallel_sum(), expected) << "repeat " << repeat;
+  mpmvv::set_threads(default_threads);
+}
+
 // ---------------------------------------------------------------- time loop
 
 // Passes every call to a real stepper and records what the time loop asked

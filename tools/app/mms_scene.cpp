@@ -917,20 +917,26 @@ class MmsCase final : public SceneCase, private RunObserver {
       // (their positions' share is their amplitude over their frequency).
       const std::size_t n = P.size();
       const bool axisymmetric = setup_.geometry == Geometry::axisymmetric;  // F_33 = F_theta (out_of_plane_stretch)
-      double pressure = 0.0, deformation = 0.0, velocity = 0.0;
       j_ratio_.resize(n);
-#pragma omp parallel for schedule(static) reduction(+ : pressure, deformation, velocity)
-      for (std::size_t p = 0; p < n; ++p) {
-        const mms::ExactFields f = setup_.solution->fields(P.reference_position[p], t);
-        j_ratio_[p] = determinant(P.deformation_gradient[p]) * (axisymmetric ? P.hoop_stretch[p] : 1.0) /
-                      (determinant(f.deformation_gradient) * f.hoop_stretch);
-        const double e = 0.5 * ((P.stress[p] - f.cauchy_stress).trace());
-        pressure += P.reference_volume[p] * e * e;
-        const double e33 = (axisymmetric ? P.hoop_stretch[p] : 1.0) - f.hoop_stretch;
-        const double e_in_plane = (P.deformation_gradient[p] - f.deformation_gradient).squaredNorm();
-        deformation += P.reference_volume[p] * (e_in_plane + e33 * e33);
-        velocity += P.reference_volume[p] * (P.velocity[p] - f.velocity).squaredNorm();
+      ThreadOrderedSums<3> sums;  // pressure, deformation, velocity: the same bits for a given thread count
+#pragma omp parallel
+      {
+        double pressure = 0.0, deformation = 0.0, velocity = 0.0;
+#pragma omp for schedule(static)
+        for (std::size_t p = 0; p < n; ++p) {
+          const mms::ExactFields f = setup_.solution->fields(P.reference_position[p], t);
+          j_ratio_[p] = determinant(P.deformation_gradient[p]) * (axisymmetric ? P.hoop_stretch[p] : 1.0) /
+                        (determinant(f.deformation_gradient) * f.hoop_stretch);
+          const double e = 0.5 * ((P.stress[p] - f.cauchy_stress).trace());
+          pressure += P.reference_volume[p] * e * e;
+          const double e33 = (axisymmetric ? P.hoop_stretch[p] : 1.0) - f.hoop_stretch;
+          const double e_in_plane = (P.deformation_gradient[p] - f.deformation_gradient).squaredNorm();
+          deformation += P.reference_volume[p] * (e_in_plane + e33 * e33);
+          velocity += P.reference_volume[p] * (P.velocity[p] - f.velocity).squaredNorm();
+        }
+        sums.keep({pressure, deformation, velocity});
       }
+      const auto [pressure, deformation, velocity] = sums.total();
       record_J_ratio(P);
       errors_.columns[column++].second.push_back(std::sqrt(pressure / weight));
       errors_.columns[column++].second.push_back(std::sqrt(deformation / weight));
