@@ -63,6 +63,82 @@ constexpr bool evaluates_lanes() {
   return false;
 }
 
+// Lane l's stencil as the shape's evaluate gives it, with an upper bound of
+// its sum_g |G_gp| (the time-step scan's; negative where the method needs
+// none): from the lane kernel's entries where the lane is listed, else from
+// evaluate.
+template <class Shape>
+void list_lane(const Shape& shape, const typename Shape::LaneBatch& batch, int l, Stencil<Shape::stencil_size>& st,
+               double& gradient_bound) {
+  if (!shape.lane_listed(batch, l)) {
+    shape.evaluate(batch.first + std::size_t(l), st);
+    gradient_bound = entry_gradient_sum_bound(st);
+    return;
+  }
+  int n = 0;
+  shape.for_each_lane_entry(batch, l, [&](int node, double w, const Vec2& gradient) {
+    st.node[n] = node;
+    st.weight[n] = w;
+    st.gradient[n] = gradient;
+    ++n;
+  });
+  st.count = n;
+  gradient_bound = shape.lane_gradient_bound(batch, l);
+}
+
+// Called by every thread of a parallel region: each particle of [begin, end)
+// the static schedule gives the thread, in order, with its stencil, as
+//   visit(p, entries, stencil_of, gradient_bound)
+// where entries(f) passes each entry to f(node, S_gp, G_gp, <S_g / r>_p),
+// stencil_of() gives the stencil itself and gradient_bound is the lane
+// kernel's bound of sum_g |G_gp| (negative where there is none). A shape that
+// evaluates by lanes gives eight stencils at a time, its entries as they
+// stand, listed as a stencil only where stencil_of is called (the scan, where
+// its bounds do not settle a speed). usable(p, inside) is asked first, with
+// the shape's test of the particle's domain in the grid (from the lanes'
+// own values where `test_box`); a particle it refuses is skipped. Ends with
+// the threads' barrier.
+template <class Shape, class Usable, class Visit>
+void for_each_stencil(const Shape& shape, std::size_t begin, std::size_t end, bool test_box, Usable usable,
+                      Visit visit) {
+  Stencil<Shape::stencil_size> s;
+  auto stencil_s = [&]() -> const Stencil<Shape::stencil_size>& { return s; };
+  if constexpr (evaluates_lanes<Shape>()) {
+    const auto [first, last] = static_block(begin, end);
+    typename Shape::LaneBatch batch;
+    for (std::size_t p0 = first; p0 < last; p0 += kLanes) {
+      const int count = int(std::min<std::size_t>(kLanes, last - p0));
+      shape.compute_lanes(p0, count, batch, test_box);
+      for (int l = 0; l < count; ++l) {
+        const std::size_t p = p0 + std::size_t(l);
+        if (!usable(p, [&] { return shape.lane_inside(batch, l); })) continue;
+        if (shape.lane_listed(batch, l)) {
+          bool listed = false;
+          auto stencil_of = [&]() -> const Stencil<Shape::stencil_size>& {
+            double bound;
+            if (!listed) list_lane(shape, batch, l, s, bound);
+            listed = true;
+            return s;
+          };
+          visit(p, [&](auto&& f) { shape.for_each_lane_entry(batch, l, f); }, stencil_of,
+                shape.lane_gradient_bound(batch, l));
+        } else {
+          shape.evaluate(p, s);
+          visit(p, entries_of(s), stencil_s, -1.0);
+        }
+      }
+    }
+#pragma omp barrier
+  } else {
+#pragma omp for schedule(static)
+    for (std::size_t p = begin; p < end; ++p) {
+      if (!usable(p, [&] { return shape.inside(p); })) continue;
+      shape.evaluate(p, s);
+      visit(p, entries_of(s), stencil_s, -1.0);
+    }
+  }
+}
+
 // A range of particles [first, last): one body of a scene with several, which
 // keep their particles contiguous. The whole set by default.
 struct ParticleRange {
@@ -146,46 +222,7 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
       }
       return true;
     };
-    Stencil<Shape::stencil_size> s;
-    auto stencil_s = [&]() -> const Stencil<Shape::stencil_size>& { return s; };
-    if constexpr (evaluates_lanes<Shape>()) {
-      // Eight stencils at a time (lanes.hpp), over the particles the static
-      // schedule gives this thread, in the same order; the kernel's entries
-      // are weighed as they stand, and listed as a stencil only for the scan
-      // that asks for one.
-      const auto [first, last] = static_block(range.first, n);
-      typename Shape::LaneBatch batch;
-      for (std::size_t p0 = first; p0 < last; p0 += kLanes) {
-        const int count = int(std::min<std::size_t>(kLanes, last - p0));
-        shape.compute_lanes(p0, count, batch, scanning);
-        for (int l = 0; l < count; ++l) {
-          const std::size_t p = p0 + std::size_t(l);
-          if (!usable(p, [&] { return shape.lane_inside(batch, l); })) continue;
-          if (shape.lane_listed(batch, l)) {
-            bool listed = false;
-            auto stencil_of = [&]() -> const Stencil<Shape::stencil_size>& {
-              double bound;
-              if (!listed) shape.list_lane(batch, l, s, bound);
-              listed = true;
-              return s;
-            };
-            map(p, [&](auto&& f) { shape.for_each_lane_entry(batch, l, f); }, stencil_of,
-                shape.lane_gradient_bound(batch, l));
-          } else {
-            shape.evaluate(p, s);
-            map(p, entries_of(s), stencil_s, -1.0);
-          }
-        }
-      }
-#pragma omp barrier
-    } else {
-#pragma omp for schedule(static)
-      for (std::size_t p = range.first; p < n; ++p) {
-        if (!usable(p, [&] { return shape.inside(p); })) continue;
-        shape.evaluate(p, s);
-        map(p, entries_of(s), stencil_s, -1.0);
-      }
-    }
+    for_each_stencil(shape, range.first, n, scanning, usable, map);
     if constexpr (scanning) {
       // A largest and a lowest: the same whatever order the threads come in.
 #pragma omp critical
@@ -345,30 +382,8 @@ void grid_to_particles(const Shape& shape, const GridFields& g, Particles& P, do
       }
       if constexpr (with_position) position_out[p] = P.position[p] + dt * velocity;
     };
-    Stencil<Shape::stencil_size> s;
-    if constexpr (evaluates_lanes<Shape>()) {
-      const auto [first, last] = static_block(range.first, n);
-      typename Shape::LaneBatch batch;
-      for (std::size_t p0 = first; p0 < last; p0 += kLanes) {
-        const int count = int(std::min<std::size_t>(kLanes, last - p0));
-        shape.compute_lanes(p0, count, batch, false);
-        for (int l = 0; l < count; ++l) {
-          const std::size_t p = p0 + std::size_t(l);
-          if (shape.lane_listed(batch, l)) {
-            update(p, [&](auto&& f) { shape.for_each_lane_entry(batch, l, f); });
-          } else {
-            shape.evaluate(p, s);
-            update(p, entries_of(s));
-          }
-        }
-      }
-    } else {
-#pragma omp for schedule(static)
-      for (std::size_t p = range.first; p < n; ++p) {
-        shape.evaluate(p, s);
-        update(p, entries_of(s));
-      }
-    }
+    for_each_stencil(shape, range.first, n, false, [](std::size_t, auto) { return true; },
+                     [&](std::size_t p, auto&& entries, auto&&, double) { update(p, entries); });
   }
 }
 

@@ -16,6 +16,7 @@
 #include "solver/shape/cpdi.hpp"
 #include "solver/shape/cpdi_lanes.hpp"
 #include "solver/shape/gimp.hpp"
+#include "solver/stages.hpp"  // list_lane
 
 namespace {
 
@@ -73,7 +74,7 @@ void expect_lanes_equal_evaluate(const Shape& shape, std::size_t n, LaneBuild bu
       EXPECT_EQ(shape.lane_inside(batch, l), shape.inside(p)) << "particle " << p;
       Stencil<N> lane;
       double bound = -2.0;
-      shape.list_lane(batch, l, lane, bound);
+      mpmvv::list_lane(shape, batch, l, lane, bound);
       if (!shape.inside(p)) {  // its stencil may leave the grid: never listed in a run
         ++outside;
         continue;

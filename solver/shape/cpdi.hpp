@@ -290,9 +290,10 @@ struct CpdiShapeT {
 
   // Eight particles' stencils in two steps: compute_lanes runs the kernel on
   // particles first, ..., first + count - 1 (count at most kLanes), then
-  // list_lane gives lane l's stencil as evaluate gives it, with an upper
-  // bound of its sum_g |G_gp| (the time-step scan's; stages.hpp:
-  // signal_speed). In between, lane_inside is `inside` of the lane's
+  // for_each_lane_entry gives lane l's entries as evaluate lists them, where
+  // lane_listed, and lane_gradient_bound an upper bound of their sum_g
+  // |G_gp| (the time-step scan's; stages.hpp: signal_speed, and list_lane
+  // for the entries as a stencil). In between, lane_inside is `inside` of the lane's
   // particle from the kernel's values, for the scan's health test: a
   // particle that fails it is not listed (its domain may leave the grid).
   // `test_box` asks the kernel for what lane_inside needs (the time-step
@@ -361,27 +362,6 @@ struct CpdiShapeT {
     requires lanes
   {
     return batch.out.gradient_bound[l];
-  }
-
-  // Lane l's stencil as evaluate gives it, with an upper bound of its
-  // sum_g |G_gp| (the time-step scan's; stages.hpp: signal_speed).
-  void list_lane(const LaneBatch& batch, int l, Stencil<stencil_size>& st, double& gradient_bound) const
-    requires lanes
-  {
-    if (!lane_listed(batch, l)) {
-      evaluate(batch.first + std::size_t(l), st);
-      gradient_bound = entry_gradient_sum_bound(st);
-      return;
-    }
-    int n = 0;
-    for_each_lane_entry(batch, l, [&](int node, double w, const Vec2& gradient) {
-      st.node[n] = node;
-      st.weight[n] = w;
-      st.gradient[n] = gradient;
-      ++n;
-    });
-    st.count = n;
-    gradient_bound = lane_gradient_bound(batch, l);
   }
 
   // A corner domain turned over, 4 det [a_1 a_2] <= 0 (monitors.hpp:

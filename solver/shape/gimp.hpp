@@ -195,20 +195,6 @@ struct GimpShapeT {
     return -1.0;
   }
 
-  void list_lane(const LaneBatch& batch, int l, Stencil<stencil_size>& st, double& gradient_bound) const
-    requires lanes
-  {
-    int n = 0;
-    for_each_lane_entry(batch, l, [&](int node, double w, const Vec2& gradient) {
-      st.node[n] = node;
-      st.weight[n] = w;
-      st.gradient[n] = gradient;
-      ++n;
-    });
-    st.count = n;
-    gradient_bound = lane_gradient_bound(batch, l);
-  }
-
   // The particle's centre lies between the walls and its domain inside the
   // grid (ghost layers included).
   // The domain's half-vectors as columns: the undeformed square (uGIMP).
