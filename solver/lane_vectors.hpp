@@ -19,6 +19,21 @@
 #error "lane_vectors.hpp is compiled once per build of the lane kernels (solver/CMakeLists.txt)"
 #endif
 
+// In the baseline build, which holds the dispatch: `call` (a function of
+// each build's namespace, with its arguments) in the namespace of `build`.
+#if defined(MPMVV_LANES_X86)
+#define MPMVV_LANE_BUILD_CALL(build, call)                           \
+  do {                                                               \
+    switch (build) {                                                 \
+      case ::mpmvv::LaneBuild::avx512: lanes::avx512::call; break;   \
+      case ::mpmvv::LaneBuild::avx2: lanes::avx2::call; break;       \
+      default: lanes::baseline::call; break;                         \
+    }                                                                \
+  } while (false)
+#else
+#define MPMVV_LANE_BUILD_CALL(build, call) lanes::baseline::call
+#endif
+
 // Inlined into the build's loop, so that no vector crosses a call (the
 // warning is about how one would be passed if it did).
 #define MPMVV_LANE_INLINE inline __attribute__((always_inline))

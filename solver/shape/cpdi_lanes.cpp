@@ -116,13 +116,7 @@ void cpdi_lane_stencils(const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiL
 
 #if defined(MPMVV_LANE_DISPATCH)
 void cpdi_lane_stencils(LaneBuild build, const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiLaneStencils& out) {
-  switch (build) {
-#if defined(MPMVV_LANES_X86)
-    case LaneBuild::avx512: lanes::avx512::cpdi_lane_stencils(grid, in, out); return;
-    case LaneBuild::avx2: lanes::avx2::cpdi_lane_stencils(grid, in, out); return;
-#endif
-    default: lanes::baseline::cpdi_lane_stencils(grid, in, out); return;
-  }
+  MPMVV_LANE_BUILD_CALL(build, cpdi_lane_stencils(grid, in, out));
 }
 
 void cpdi_lane_stencils(const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiLaneStencils& out) {

@@ -98,13 +98,7 @@ void gimp_lane_stencils(const GimpLaneGrid& grid, const GimpLaneInput& in, GimpL
 
 #if defined(MPMVV_LANE_DISPATCH)
 void gimp_lane_stencils(LaneBuild build, const GimpLaneGrid& grid, const GimpLaneInput& in, GimpLaneStencils& out) {
-  switch (build) {
-#if defined(MPMVV_LANES_X86)
-    case LaneBuild::avx512: lanes::avx512::gimp_lane_stencils(grid, in, out); return;
-    case LaneBuild::avx2: lanes::avx2::gimp_lane_stencils(grid, in, out); return;
-#endif
-    default: lanes::baseline::gimp_lane_stencils(grid, in, out); return;
-  }
+  MPMVV_LANE_BUILD_CALL(build, gimp_lane_stencils(grid, in, out));
 }
 
 void gimp_lane_stencils(const GimpLaneGrid& grid, const GimpLaneInput& in, GimpLaneStencils& out) {

@@ -1,0 +1,38 @@
+// Elementary functions of whole arrays, computed in lanes (lanes.hpp) by the
+// same operations in every build, so that a run gives the same bits on any
+// x86-64, whichever build the CPU picks.
+//
+// Why: a body force that turns with each particle's angle calls sin and cos
+// once per particle per step (mms/ring.hpp), and libm's scalar sincos was a
+// ninth of a CPDI step's instructions on the ring.
+#pragma once
+
+#include <cstddef>
+
+#include "lanes.hpp"
+
+namespace mpmvv {
+
+// Where |x| is at most this, sin and cos come from the lanes' reduction and
+// polynomials (lane_math.cpp); beyond it, and for x not finite, from libm.
+inline constexpr double kLaneSinCosLimit = 1.0e6;
+
+// sin x_k and cos x_k for k < n, each within one unit in the last place of
+// the exact value (tests/test_lane_math.cpp measures the largest error).
+// `build` names a build the CPU has (cpu_has); by default the one the
+// kernels run (lane_build).
+void lane_sincos(std::size_t n, const double* x, double* sin_x, double* cos_x);
+void lane_sincos(LaneBuild build, std::size_t n, const double* x, double* sin_x, double* cos_x);
+
+// Each build's own, compiled for its instructions (solver/CMakeLists.txt).
+namespace lanes::avx512 {
+void sincos_array(std::size_t n, const double* x, double* sin_x, double* cos_x);
+}
+namespace lanes::avx2 {
+void sincos_array(std::size_t n, const double* x, double* sin_x, double* cos_x);
+}
+namespace lanes::baseline {
+void sincos_array(std::size_t n, const double* x, double* sin_x, double* cos_x);
+}
+
+}  // namespace mpmvv
