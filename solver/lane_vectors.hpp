@@ -13,6 +13,10 @@
 
 #include <cstring>
 
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
 #include "lanes.hpp"
 
 #if !defined(MPMVV_LANE_BUILD_NS) || !defined(MPMVV_LANE_WIDTH)
@@ -76,6 +80,29 @@ MPMVV_LANE_INLINE V load(const double* a) {
 template <class V, class T>
 MPMVV_LANE_INLINE void store(T* a, const V& v) {
   std::memcpy(a, &v, sizeof v);
+}
+
+template <class V>
+MPMVV_LANE_INLINE V lane_abs(const V& a) {
+  return a < 0.0 ? -a : a;
+}
+
+// The correctly rounded square root of each lane, as std::sqrt gives it.
+template <class V>
+MPMVV_LANE_INLINE V lane_sqrt(const V& a) {
+#if defined(__AVX512F__)
+  // (masked with every lane set: the unmasked form trips a false warning of GCC 12)
+  if constexpr (sizeof(V) == 64) return V(_mm512_mask_sqrt_pd(__m512d(a), __mmask8(0xff), __m512d(a)));
+#endif
+#if defined(__AVX__)
+  if constexpr (sizeof(V) == 32) return V(_mm256_sqrt_pd(__m256d(a)));
+#endif
+#if defined(__SSE2__)
+  if constexpr (sizeof(V) == 16) return V(_mm_sqrt_pd(__m128d(a)));
+#endif
+  V r;
+  for (int l = 0; l < int(sizeof(V) / sizeof(double)); ++l) r[l] = __builtin_sqrt(a[l]);
+  return r;
 }
 
 template <class V>

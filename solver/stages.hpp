@@ -19,6 +19,8 @@
 
 #include "geometry.hpp"
 #include "grid.hpp"
+#include "material/neo_hookean.hpp"
+#include "material/neo_hookean_lanes.hpp"
 #include "material/stress.hpp"
 #include "parallel.hpp"
 #include "particles.hpp"
@@ -96,11 +98,14 @@ void list_lane(const Shape& shape, const typename Shape::LaneBatch& batch, int l
 // stand, listed as a stencil only where stencil_of is called (the scan, where
 // its bounds do not settle a speed). usable(p, inside) is asked first, with
 // the shape's test of the particle's domain in the grid (from the lanes'
-// own values where `test_box`); a particle it refuses is skipped. Ends with
-// the threads' barrier.
-template <class Shape, class Usable, class Visit>
+// own values where `test_box`); a particle it refuses is skipped. With lanes,
+// `on_lanes(first, count, batch)` sees each batch before its particles are
+// visited. Ends with the threads' barrier.
+struct NoLaneHook {};
+
+template <class Shape, class Usable, class Visit, class OnLanes = NoLaneHook>
 void for_each_stencil(const Shape& shape, std::size_t begin, std::size_t end, bool test_box, Usable usable,
-                      Visit visit) {
+                      Visit visit, OnLanes on_lanes = {}) {
   Stencil<Shape::stencil_size> s;
   auto stencil_s = [&]() -> const Stencil<Shape::stencil_size>& { return s; };
   if constexpr (evaluates_lanes<Shape>()) {
@@ -109,6 +114,7 @@ void for_each_stencil(const Shape& shape, std::size_t begin, std::size_t end, bo
     for (std::size_t p0 = first; p0 < last; p0 += kLanes) {
       const int count = int(std::min<std::size_t>(kLanes, last - p0));
       shape.compute_lanes(p0, count, batch, test_box);
+      if constexpr (!std::is_same_v<OnLanes, NoLaneHook>) on_lanes(p0, count, batch);
       for (int l = 0; l < count; ++l) {
         const std::size_t p = p0 + std::size_t(l);
         if (!usable(p, [&] { return shape.lane_inside(batch, l); })) continue;
@@ -150,6 +156,14 @@ struct ParticleRange {
 // A map without a scan (ScanInMap, below).
 struct NoScan {};
 
+// The scan's screen of a batch of lanes (ScanInMap::screen_lanes), where it
+// makes one: the verdicts of particles first, ..., first + kLanes - 1.
+struct ScanScreen {
+  bool valid = false;
+  std::size_t first = 0;
+  NeoHookeanScanLaneVerdict verdict;
+};
+
 // Sums the particle quantities selected by `Fields` onto the grid and stores
 // them in `g`, overwriting those node fields (the others are left as they are).
 // kAffineMomentum reads the node positions from `grid`. With `scan` (a
@@ -177,11 +191,13 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
     std::fill(sums, sums + nodes, NodeSums{0.0, 0.0, 0.0, 0.0, 0.0});
     [[maybe_unused]] double max_speed = 0.0;
     [[maybe_unused]] std::size_t first_unhealthy = P.size();
+    [[maybe_unused]] ScanScreen screen;  // the scan's look at the batch of lanes at hand
     // `entries(f)` passes each entry of the particle's stencil to f;
     // `stencil_of()` gives the stencil itself, which the scan asks for only
     // where its bounds do not settle the particle's speed.
     auto map = [&](std::size_t p, auto&& entries, auto&& stencil_of, double gradient_bound) {
-      if constexpr (scanning) max_speed = std::max(max_speed, scan->speed(p, stencil_of, max_speed, gradient_bound));
+      if constexpr (scanning)
+        max_speed = std::max(max_speed, scan->speed(p, stencil_of, max_speed, gradient_bound, screen));
       const double m = P.mass[p];
       Vec2 momentum = Vec2::Zero(), body = Vec2::Zero();
       Mat2 volume_stress = Mat2::Zero();
@@ -215,14 +231,20 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
     // is the shape's test of it (the lanes have it from their kernel).
     auto usable = [&](std::size_t p, auto inside) {
       if constexpr (scanning) {
-        if (!scan->healthy(p, inside)) {
+        if (!scan->healthy(p, inside, screen)) {
           first_unhealthy = std::min(first_unhealthy, p);
           return false;
         }
       }
       return true;
     };
-    for_each_stencil(shape, range.first, n, scanning, usable, map);
+    if constexpr (scanning) {
+      for_each_stencil(shape, range.first, n, true, usable, map, [&](std::size_t first, int count, const auto& batch) {
+        scan->screen_lanes(first, count, batch, max_speed, screen);
+      });
+    } else {
+      for_each_stencil(shape, range.first, n, false, usable, map);
+    }
     if constexpr (scanning) {
       // A largest and a lowest: the same whatever order the threads come in.
 #pragma omp critical
@@ -850,14 +872,62 @@ struct ScanInMap {
   double h;
   ParticleScan result{0.0, P.size()};
 
+  // Where the material has a lane kernel of the scan's first tests
+  // (neo_hookean_lanes.hpp) and the shape evaluates by lanes, the batch's
+  // particles are screened together into `screen`: the scan then asks each
+  // only of what the screen left open. Otherwise the screen stays empty.
+  static constexpr bool screens = std::is_same_v<Material, NeoHookean> && evaluates_lanes<Shape>() &&
+                                  Shape::geometry == Geometry::plane_strain &&
+                                  !requires(const Shape& s) { s.cell_stretch(std::size_t(0)); };
+
+  template <class Batch>
+  void screen_lanes(std::size_t first, int count, const Batch& batch, double largest, ScanScreen& screen) const {
+    if constexpr (screens) {
+      const NeoHookeanScanLaneParams params{material.lambda, material.mu, material.p_wave_modulus(), largest, h,
+                                            1.0 / kGridBasisGradientBound, Shape::gradients_beyond_grid_basis};
+      NeoHookeanScanLaneInput in;
+      for (int l = 0; l < kLanes; ++l) {
+        const int k = l < count ? l : 0;  // spare lanes repeat the first
+        const std::size_t p = first + std::size_t(k);
+        const Mat2& F = P.deformation_gradient[p];
+        const Mat2& sigma = P.stress[p];
+        in.x[l] = P.position[p].x();
+        in.y[l] = P.position[p].y();
+        in.mass[l] = P.mass[p];
+        in.volume[l] = P.volume[p];
+        in.vx[l] = P.velocity[p].x();
+        in.vy[l] = P.velocity[p].y();
+        in.f00[l] = F(0, 0);
+        in.f10[l] = F(1, 0);
+        in.f01[l] = F(0, 1);
+        in.f11[l] = F(1, 1);
+        in.s00[l] = sigma(0, 0);
+        in.s10[l] = sigma(1, 0);
+        in.s01[l] = sigma(0, 1);
+        in.s11[l] = sigma(1, 1);
+        in.gradient_bound[l] = shape.lane_listed(batch, k) ? shape.lane_gradient_bound(batch, k) : -1.0;
+      }
+      neo_hookean_scan_lanes(params, in, screen.verdict);
+      screen.first = first;
+      screen.valid = true;
+    }
+  }
+
   template <class Inside>
-  bool healthy(std::size_t p, Inside inside) const {
+  bool healthy(std::size_t p, Inside inside, const ScanScreen& screen = {}) const {
+    if constexpr (screens) {
+      if (screen.valid) return screen.verdict.sound[p - screen.first] != 0 && inside();
+    }
     return particle_healthy(shape, P, p, inside);
   }
   // `stencil_of()` gives the particle's stencil; `gradient_bound` is its
   // entry_gradient_sum_bound where the caller has it, else negative.
   template <class StencilOf>
-  double speed(std::size_t p, StencilOf stencil_of, double largest, double gradient_bound = -1.0) const {
+  double speed(std::size_t p, StencilOf stencil_of, double largest, double gradient_bound = -1.0,
+               const ScanScreen& screen = {}) const {
+    if constexpr (screens) {
+      if (screen.valid && screen.verdict.may_set_speed[p - screen.first] == 0) return 0.0;
+    }
     return signal_speed(shape, material, P, h, p, largest, stencil_of, gradient_bound);
   }
 };

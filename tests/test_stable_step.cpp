@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <limits>
 #include <memory>
 #include <random>
 #include <string>
@@ -465,5 +466,97 @@ TEST(StableStep, TheScansEarlyTestLeavesTheLargestSpeedAsItIs) {
     EXPECT_EQ(mpmvv::scan_particles(gimp, solid, P, model.grid.h).max_signal_speed, gimp_full);
     EXPECT_LT(mpmvv::scan_particles(gimp, BelowTheWaveModulus{unbounded}, P, model.grid.h).max_signal_speed,
               gimp_full);
+  }
+}
+
+// The lanes' screen of the scan (material/neo_hookean_lanes.hpp), from every
+// build the CPU has: a particle is sound exactly where its state is finite
+// with J > 0, and ruled out exactly where the scalar test rules it out
+// (signal_speed returns 0) with the same largest speed (a domain stretched
+// past 2 x 2 cells is left to the scalar test); over sheared and
+// stretched CPDI domains, fast and slow particles, and states with NaN, an
+// infinite stress or a turned-over F, at three largest speeds.
+TEST(StableStep, TheLanesScreenRulesOutWhatTheScalarTestDoes) {
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> where(4.0, 12.0), unit(-1.0, 1.0);
+  const NeoHookean solid{576923.0769230769, 384615.3846153846};
+  Model model;
+  model.grid = GridGeometry::walled(Vec2::Zero(), 1.0, 16, 16);
+  Particles& P = model.particles;
+  P.resize(4000);
+  P.half_size.assign(P.size(), Vec2(0.25, 0.25));
+  const double c0 = std::sqrt(solid.p_wave_modulus() / kDensity);
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    P.position[p] = Vec2(where(rng), where(rng));
+    const double shear = p % 3 == 0 ? 0.0 : 0.4 * where(rng) - 1.6;
+    P.deformation_gradient[p] =
+        rotation(where(rng)) * simple_shear(shear) * mpmvv::testing::random_deformation(rng, 0.3, 0.4);
+    P.velocity[p] = (p % 5 == 0 ? 2.0 : 0.1) * c0 * Vec2(unit(rng), unit(rng));
+    P.reference_volume[p] = 0.25;
+    P.volume[p] = mpmvv::determinant(P.deformation_gradient[p]) * P.reference_volume[p];
+    P.mass[p] = kDensity * P.reference_volume[p];
+    P.stress[p] = solid.cauchy_stress(P.deformation_gradient[p]);
+    if (p % 97 == 1) P.velocity[p].x() = std::nan("");
+    if (p % 89 == 2) P.stress[p](1, 0) = std::numeric_limits<double>::infinity();
+    if (p % 83 == 3) P.deformation_gradient[p].col(0) *= -1.0;
+  }
+  const CpdiShape shape = CpdiShape::bind(model.grid, P);
+  const double largest_speed = mpmvv::scan_particles(shape, WithoutBound{solid}, P, model.grid.h).max_signal_speed;
+  std::vector<mpmvv::LaneBuild> builds;
+  for (auto b : {mpmvv::LaneBuild::baseline, mpmvv::LaneBuild::avx2, mpmvv::LaneBuild::avx512})
+    if (mpmvv::cpu_has(b)) builds.push_back(b);
+  for (const mpmvv::LaneBuild build : builds) {
+    SCOPED_TRACE(mpmvv::name(build));
+    std::size_t ruled_out = 0, formed = 0, unsound = 0;
+    for (const double fraction : {0.3, 0.7, 1.0}) {
+      const double largest = fraction * largest_speed;
+      for (std::size_t first = 0; first < P.size(); first += mpmvv::kLanes) {
+        CpdiShape::LaneBatch batch;
+        shape.compute_lanes(first, mpmvv::kLanes, batch, true, &build);
+        mpmvv::NeoHookeanScanLaneInput in;
+        for (int l = 0; l < mpmvv::kLanes; ++l) {
+          const std::size_t p = first + std::size_t(l);
+          const Mat2& F = P.deformation_gradient[p];
+          const Mat2& s = P.stress[p];
+          in.x[l] = P.position[p].x(), in.y[l] = P.position[p].y();
+          in.mass[l] = P.mass[p], in.volume[l] = P.volume[p];
+          in.vx[l] = P.velocity[p].x(), in.vy[l] = P.velocity[p].y();
+          in.f00[l] = F(0, 0), in.f10[l] = F(1, 0), in.f01[l] = F(0, 1), in.f11[l] = F(1, 1);
+          in.s00[l] = s(0, 0), in.s10[l] = s(1, 0), in.s01[l] = s(0, 1), in.s11[l] = s(1, 1);
+          in.gradient_bound[l] = shape.lane_listed(batch, l) ? shape.lane_gradient_bound(batch, l) : -1.0;
+        }
+        const mpmvv::NeoHookeanScanLaneParams params{solid.lambda, solid.mu, solid.p_wave_modulus(), largest,
+                                                     model.grid.h, 1.0 / mpmvv::kGridBasisGradientBound, true};
+        mpmvv::NeoHookeanScanLaneVerdict verdict;
+        mpmvv::neo_hookean_scan_lanes(build, params, in, verdict);
+        for (int l = 0; l < mpmvv::kLanes; ++l) {
+          const std::size_t p = first + std::size_t(l);
+          const bool finite = P.position[p].allFinite() && P.velocity[p].allFinite() &&
+                              P.deformation_gradient[p].allFinite() && P.stress[p].allFinite();
+          const bool sound = finite && mpmvv::determinant(P.deformation_gradient[p]) > 0.0;
+          ASSERT_EQ(verdict.sound[l] != 0, sound) << "particle " << p;
+          if (!sound) {
+            EXPECT_NE(verdict.may_set_speed[l], 0) << "particle " << p;
+            unsound += fraction == 1.0;
+            continue;
+          }
+          mpmvv::Stencil<CpdiShape::stencil_size> st;
+          shape.evaluate(p, st);
+          auto stencil_of = [&]() -> const mpmvv::Stencil<CpdiShape::stencil_size>& { return st; };
+          const double speed =
+              mpmvv::signal_speed(shape, solid, P, model.grid.h, p, largest, stencil_of, in.gradient_bound[l]);
+          // A lane with no stencil bound (a domain past 2 x 2 cells) is left to the scalar test.
+          if (shape.lane_listed(batch, l))
+            EXPECT_EQ(verdict.may_set_speed[l] == 0, speed == 0.0) << "particle " << p << ", largest " << largest;
+          else
+            EXPECT_NE(verdict.may_set_speed[l], 0) << "particle " << p;
+          (verdict.may_set_speed[l] == 0 ? ruled_out : formed) += 1;
+        }
+      }
+    }
+    // Both verdicts occur, and every kind of unsound state.
+    EXPECT_GT(ruled_out, P.size());
+    EXPECT_GT(formed, 100u);
+    EXPECT_GT(unsound, 100u);
   }
 }

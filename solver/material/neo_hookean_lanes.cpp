@@ -1,0 +1,86 @@
+// The lane kernel of neo_hookean_lanes.hpp (lane_vectors.hpp says how it is
+// built). Each line is the scalar line it repeats: particle_healthy and
+// signal_speed (stages.hpp), NeoHookean::wave_modulus_bound (neo_hookean.hpp),
+// in plane strain (F_33 = 1); std::max(a, b) is a < b ? b : a.
+#include "neo_hookean_lanes.hpp"
+
+#include "../lane_vectors.hpp"
+
+namespace mpmvv {
+
+namespace {
+
+using namespace lanes::MPMVV_LANE_BUILD_NS;
+
+struct NeoHookeanScanKernel {
+  using Grid = NeoHookeanScanLaneParams;
+  using In = NeoHookeanScanLaneInput;
+  using Out = NeoHookeanScanLaneVerdict;
+
+  template <int W>
+  MPMVV_LANE_INLINE static void body(const Grid& g, const In& in, Out& out, int l0);
+};
+
+template <class V>
+MPMVV_LANE_INLINE V larger(const V& a, const V& b) {  // std::max
+  return a < b ? b : a;
+}
+
+template <int W>
+void NeoHookeanScanKernel::body(const Grid& g, const In& in, Out& out, int l0) {
+  using Lanes = typename Width<W>::Lanes;
+  using Mask = typename Width<W>::Mask;
+  using Ints = typename Width<W>::Ints;
+  const Lanes zero = {};
+  const Lanes vx = load<Lanes>(in.vx + l0), vy = load<Lanes>(in.vy + l0);
+  const Lanes f00 = load<Lanes>(in.f00 + l0), f10 = load<Lanes>(in.f10 + l0);
+  const Lanes f01 = load<Lanes>(in.f01 + l0), f11 = load<Lanes>(in.f11 + l0);
+  const Lanes s00 = load<Lanes>(in.s00 + l0), s10 = load<Lanes>(in.s10 + l0);
+  const Lanes s01 = load<Lanes>(in.s01 + l0), s11 = load<Lanes>(in.s11 + l0);
+  // particle_healthy: 0 x is +-0 for a finite x and NaN otherwise.
+  const Lanes finite = ((0.0 * load<Lanes>(in.x + l0) + 0.0 * load<Lanes>(in.y + l0)) + (0.0 * vx + 0.0 * vy)) +
+                       ((0.0 * f00 + 0.0 * f10 + 0.0 * f01 + 0.0 * f11) + (0.0 * s00 + 0.0 * s10 + 0.0 * s01 + 0.0 * s11));
+  const Lanes J = f00 * f11 - f01 * f10;  // determinant(F) F_33
+  const Mask sound = (finite == zero) & (J > zero);
+  // signal_speed's test.
+  const Lanes density = load<Lanes>(in.mass + l0) / load<Lanes>(in.volume + l0);
+  const Lanes v = lane_sqrt(vx * vx + vy * vy);
+  const Lanes room = g.largest * (1.0 - 1e-9) - v;
+  // wave_modulus_bound
+  const Lanes shear = larger(lane_abs(g.mu - g.lambda * (J - 1.0)), lane_abs(g.mu - g.lambda * (1.0 - 1.0 / J)));
+  Lanes modulus = ((g.lambda < 0.0 ? -g.lambda : g.lambda) + 2.0 * shear) / J +
+                  larger(larger(s00, s11) + lane_abs(s01), zero);
+  Mask must_form = {};
+  if (g.stiffens) {
+    const Lanes bound = load<Lanes>(in.gradient_bound + l0);
+    const Lanes most = larger(zero + 1.0, g.h * bound * g.inverse_basis_bound * (1.0 + 1e-12));
+    modulus = larger(modulus, most * most * g.p_wave_modulus);
+    must_form = bound < zero;
+  }
+  const Mask ruled_out = sound & (room > zero) & (modulus <= density * room * room) & ~must_form;
+  store(out.sound + l0, __builtin_convertvector(sound, Ints));
+  store(out.may_set_speed + l0, __builtin_convertvector(~ruled_out, Ints));
+}
+
+}  // namespace
+
+namespace lanes::MPMVV_LANE_BUILD_NS {
+void neo_hookean_scan_lanes(const NeoHookeanScanLaneParams& params, const NeoHookeanScanLaneInput& in,
+                            NeoHookeanScanLaneVerdict& out) {
+  run<NeoHookeanScanKernel>(params, in, out);
+}
+}  // namespace lanes::MPMVV_LANE_BUILD_NS
+
+#if defined(MPMVV_LANE_DISPATCH)
+void neo_hookean_scan_lanes(LaneBuild build, const NeoHookeanScanLaneParams& params,
+                            const NeoHookeanScanLaneInput& in, NeoHookeanScanLaneVerdict& out) {
+  MPMVV_LANE_BUILD_CALL(build, neo_hookean_scan_lanes(params, in, out));
+}
+
+void neo_hookean_scan_lanes(const NeoHookeanScanLaneParams& params, const NeoHookeanScanLaneInput& in,
+                            NeoHookeanScanLaneVerdict& out) {
+  neo_hookean_scan_lanes(lane_build(), params, in, out);
+}
+#endif
+
+}  // namespace mpmvv

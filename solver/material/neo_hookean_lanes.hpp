@@ -1,0 +1,80 @@
+// The time-step scan's first look at eight particles of a neo-Hookean solid
+// at once, each in a lane (lanes.hpp), before the particle-to-grid map
+// weighs them (stages.hpp: ScanInMap): whether each particle's state is
+// finite with J > 0 (particle_healthy without its test of the domain in the
+// grid), and whether its signal speed could set a new largest one
+// (signal_speed's test by wave_modulus_bound, neo_hookean.hpp). A lane the
+// test rules out is one the scalar test rules out too: the lanes repeat its
+// operations in its order, with the largest speed as the batch found it,
+// which is no larger than the scalar test's.
+//
+// Why: that test waits on a square root and two divisions per particle. On
+// the CPDI ring (256 cells, one thread) a second scalar test per particle
+// added 23 ns to a 135 ns particle-step; screened by lanes, the map with its
+// scan went from 67-70 to 58-63 ns.
+#pragma once
+
+#include "../lanes.hpp"
+
+namespace mpmvv {
+
+struct NeoHookeanScanLaneParams {
+  double lambda, mu;
+  double p_wave_modulus;       // lambda + 2 mu
+  double largest;              // the largest signal speed so far
+  double h;                    // the cell size
+  double inverse_basis_bound;  // 1 / kGridBasisGradientBound (stages.hpp)
+  bool stiffens;               // the shape's gradients reach beyond the grid basis (k_p, stages.hpp)
+};
+
+// Each lane's particle: x_p, m_p, V_p, v_p, F_p, sigma_p (in plane strain),
+// and its stencil's bound of sum_g |G_gp| (negative where there is none).
+struct NeoHookeanScanLaneInput {
+  alignas(64) double x[kLanes];
+  alignas(64) double y[kLanes];
+  alignas(64) double mass[kLanes];
+  alignas(64) double volume[kLanes];
+  alignas(64) double vx[kLanes];
+  alignas(64) double vy[kLanes];
+  alignas(64) double f00[kLanes];
+  alignas(64) double f10[kLanes];
+  alignas(64) double f01[kLanes];
+  alignas(64) double f11[kLanes];
+  alignas(64) double s00[kLanes];
+  alignas(64) double s10[kLanes];
+  alignas(64) double s01[kLanes];
+  alignas(64) double s11[kLanes];
+  alignas(64) double gradient_bound[kLanes];
+};
+
+// Per lane: `sound`, nonzero where the state is finite and J > 0;
+// `may_set_speed`, nonzero where the speed must be formed, i.e. the test
+// could not rule the particle out (a stiffening shape without the stencil's
+// bound, or a state that is not sound, is never ruled out).
+struct NeoHookeanScanLaneVerdict {
+  alignas(32) int sound[kLanes];
+  alignas(32) int may_set_speed[kLanes];
+};
+
+// With the build the kernels run (lane_build), or with a given one, which
+// the CPU must have (cpu_has).
+void neo_hookean_scan_lanes(const NeoHookeanScanLaneParams& params, const NeoHookeanScanLaneInput& in,
+                            NeoHookeanScanLaneVerdict& out);
+void neo_hookean_scan_lanes(LaneBuild build, const NeoHookeanScanLaneParams& params,
+                            const NeoHookeanScanLaneInput& in, NeoHookeanScanLaneVerdict& out);
+
+// Each build's own, compiled for its instructions (solver/CMakeLists.txt).
+namespace lanes::avx512 {
+void neo_hookean_scan_lanes(const NeoHookeanScanLaneParams& params, const NeoHookeanScanLaneInput& in,
+                            NeoHookeanScanLaneVerdict& out);
+}
+namespace lanes::avx2 {
+void neo_hookean_scan_lanes(const NeoHookeanScanLaneParams& params, const NeoHookeanScanLaneInput& in,
+                            NeoHookeanScanLaneVerdict& out);
+}
+namespace lanes::baseline {
+void neo_hookean_scan_lanes(const NeoHookeanScanLaneParams& params, const NeoHookeanScanLaneInput& in,
+                            NeoHookeanScanLaneVerdict& out);
+}
+
+}  // namespace mpmvv
