@@ -1,11 +1,14 @@
-// What the tests share: deformation gradients and number formatting.
+// What the tests share: deformation gradients, number formatting and the
+// builds of the lane kernels this CPU can run.
 #pragma once
 
 #include <cmath>
 #include <cstdio>
 #include <random>
 #include <string>
+#include <vector>
 
+#include "solver/lanes.hpp"
 #include "solver/tensor.hpp"
 
 namespace mpmvv::testing {
@@ -43,6 +46,14 @@ Mat2 random_deformation(Rng& rng, double spread, double min_det) {
     f(1, 1) += u(rng);
     if (determinant(f) >= min_det) return f;
   }
+}
+
+// Every build of the lane kernels (solver/lanes.hpp) the CPU has, baseline first.
+inline std::vector<LaneBuild> lane_builds_of_this_cpu() {
+  std::vector<LaneBuild> builds;
+  for (LaneBuild b : {LaneBuild::baseline, LaneBuild::avx2, LaneBuild::avx512})
+    if (cpu_has(b)) builds.push_back(b);
+  return builds;
 }
 
 }  // namespace mpmvv::testing

@@ -3,6 +3,8 @@
 // kernels this CPU can run, and libm's values beyond the reduction's range.
 #include <gtest/gtest.h>
 
+#include "support.hpp"
+
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -48,13 +50,6 @@ std::vector<double> arguments() {
   return x;
 }
 
-std::vector<LaneBuild> builds_of_this_cpu() {
-  std::vector<LaneBuild> builds;
-  for (LaneBuild b : {LaneBuild::baseline, LaneBuild::avx2, LaneBuild::avx512})
-    if (mpmvv::cpu_has(b)) builds.push_back(b);
-  return builds;
-}
-
 // Measured largest errors on this set: 0.72 ulp (sin) and 0.75 ulp (cos).
 TEST(LaneSinCos, WithinOneUnitInTheLastPlace) {
   const std::vector<double> x = arguments();
@@ -85,8 +80,8 @@ TEST(LaneSinCos, EveryBuildAndCountGivesTheSameBits) {
   const std::vector<double> x = arguments();
   std::vector<double> s0(x.size()), c0(x.size());
   mpmvv::lane_sincos(LaneBuild::baseline, x.size(), x.data(), s0.data(), c0.data());
-  ASSERT_FALSE(builds_of_this_cpu().empty());
-  for (LaneBuild build : builds_of_this_cpu()) {
+  ASSERT_FALSE(mpmvv::testing::lane_builds_of_this_cpu().empty());
+  for (LaneBuild build : mpmvv::testing::lane_builds_of_this_cpu()) {
     SCOPED_TRACE(mpmvv::name(build));
     std::vector<double> s(x.size()), c(x.size());
     mpmvv::lane_sincos(build, x.size(), x.data(), s.data(), c.data());
@@ -110,7 +105,7 @@ TEST(LaneSinCos, BeyondTheLimitTheValuesAreLibms) {
   const double inf = std::numeric_limits<double>::infinity();
   const std::vector<double> x = {std::nextafter(mpmvv::kLaneSinCosLimit, inf), -3e7, 1e300, inf, -inf,
                                  std::numeric_limits<double>::quiet_NaN(), 12.5};
-  for (LaneBuild build : builds_of_this_cpu()) {
+  for (LaneBuild build : mpmvv::testing::lane_builds_of_this_cpu()) {
     SCOPED_TRACE(mpmvv::name(build));
     std::vector<double> s(x.size()), c(x.size());
     mpmvv::lane_sincos(build, x.size(), x.data(), s.data(), c.data());

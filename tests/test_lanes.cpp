@@ -5,6 +5,8 @@
 // last bit.
 #include <gtest/gtest.h>
 
+#include "support.hpp"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -109,18 +111,11 @@ void expect_lanes_equal_evaluate(const Shape& shape, std::size_t n, LaneBuild bu
   }
 }
 
-std::vector<LaneBuild> builds_of_this_cpu() {
-  std::vector<LaneBuild> builds;
-  for (LaneBuild b : {LaneBuild::baseline, LaneBuild::avx2, LaneBuild::avx512})
-    if (mpmvv::cpu_has(b)) builds.push_back(b);
-  return builds;
-}
-
 TEST(CpdiLanes, EveryBuildGivesTheScalarStencilsBitForBit) {
   const GridGeometry grid = GridGeometry::walled(Vec2(-0.3, 0.1), 0.05, 18, 18);
   const Particles P = random_particles(grid, 203, 5);  // 25 lanes of 8 and 3 over
-  ASSERT_FALSE(builds_of_this_cpu().empty());
-  for (LaneBuild build : builds_of_this_cpu()) {
+  ASSERT_FALSE(mpmvv::testing::lane_builds_of_this_cpu().empty());
+  for (LaneBuild build : mpmvv::testing::lane_builds_of_this_cpu()) {
     SCOPED_TRACE(mpmvv::name(build));
     expect_lanes_equal_evaluate(CpdiShape::bind(grid, P), P.size(), build);
     // The deliberate faults' factors (faults.hpp) go through the kernel too.
@@ -141,7 +136,7 @@ TEST(CpdiLanes, TurnedDomainsTooBitForBit) {
     P.domain_axes[p] << 0.25 * grid.h * c, -0.2 * grid.h * s, 0.25 * grid.h * s, 0.2 * grid.h * c;
   }
   using Turned = CpdiShapeT<Geometry::plane_strain, CpdiForm::turned>;
-  for (LaneBuild build : builds_of_this_cpu()) {
+  for (LaneBuild build : mpmvv::testing::lane_builds_of_this_cpu()) {
     SCOPED_TRACE(mpmvv::name(build));
     expect_lanes_equal_evaluate(Turned::bind(grid, P), P.size(), build);
   }
@@ -165,8 +160,8 @@ TEST(GimpLanes, EveryBuildGivesTheScalarStencilsBitForBit) {
   }
   P.position[0] = grid.origin + grid.h * Vec2(0.25, 0.25);  // on the edges' limit
   P.position[1] = grid.origin + grid.h * Vec2(grid.cells_x - 0.25, 3.5);  // half-way between nodes
-  ASSERT_FALSE(builds_of_this_cpu().empty());
-  for (LaneBuild build : builds_of_this_cpu()) {
+  ASSERT_FALSE(mpmvv::testing::lane_builds_of_this_cpu().empty());
+  for (LaneBuild build : mpmvv::testing::lane_builds_of_this_cpu()) {
     SCOPED_TRACE(mpmvv::name(build));
     expect_lanes_equal_evaluate(GimpShape::bind(grid, P), n, build);
   }
@@ -182,7 +177,7 @@ TEST(LaneBuilds, TheEnvironmentNamesABuildTheCpuHas) {
   EXPECT_TRUE(mpmvv::cpu_has(widest));
   ::setenv("MPMVV_LANE_BUILD", "baseline", 1);
   EXPECT_EQ(mpmvv::widest_lane_build(), LaneBuild::baseline);
-  for (LaneBuild b : builds_of_this_cpu()) {
+  for (LaneBuild b : mpmvv::testing::lane_builds_of_this_cpu()) {
     ::setenv("MPMVV_LANE_BUILD", mpmvv::name(b), 1);
     EXPECT_EQ(mpmvv::widest_lane_build(), b) << mpmvv::name(b);
   }

@@ -412,6 +412,31 @@ struct BelowTheWaveModulus : WithoutBound {
   }
 };
 
+// n particles spread over a 16 x 16-cell grid with sheared, stretched and
+// compressed CPDI domains, a fifth of them fast (twice the small-strain wave
+// speed), the rest slow, each stressed as its F says.
+Model scanned_particles(const NeoHookean& solid, std::size_t n, std::mt19937& rng) {
+  std::uniform_real_distribution<double> where(4.0, 12.0), unit(-1.0, 1.0);
+  Model model;
+  model.grid = GridGeometry::walled(Vec2::Zero(), 1.0, 16, 16);
+  Particles& P = model.particles;
+  P.resize(n);
+  P.half_size.assign(P.size(), Vec2(0.25, 0.25));
+  const double c0 = std::sqrt(solid.p_wave_modulus() / kDensity);
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    P.position[p] = Vec2(where(rng), where(rng));
+    const double shear = p % 3 == 0 ? 0.0 : 0.4 * where(rng) - 1.6;
+    P.deformation_gradient[p] =
+        rotation(where(rng)) * simple_shear(shear) * mpmvv::testing::random_deformation(rng, 0.3, 0.4);
+    P.velocity[p] = (p % 5 == 0 ? 2.0 : 0.1) * c0 * Vec2(unit(rng), unit(rng));
+    P.reference_volume[p] = 0.25;
+    P.volume[p] = mpmvv::determinant(P.deformation_gradient[p]) * P.reference_volume[p];
+    P.mass[p] = kDensity * P.reference_volume[p];
+    P.stress[p] = solid.cauchy_stress(P.deformation_gradient[p]);
+  }
+  return model;
+}
+
 }  // namespace
 
 // The scan leaves out a particle whose bound cannot beat the largest speed so
@@ -421,25 +446,10 @@ struct BelowTheWaveModulus : WithoutBound {
 // sheared, stretched and compressed CPDI domains, some at rest and some fast.
 TEST(StableStep, TheScansEarlyTestLeavesTheLargestSpeedAsItIs) {
   std::mt19937 rng(17);
-  std::uniform_real_distribution<double> where(4.0, 12.0), unit(-1.0, 1.0);
   for (const NeoHookean& solid : {kSolid, NeoHookean{576923.0769230769, 384615.3846153846}}) {
-    Model model;
-    model.grid = GridGeometry::walled(Vec2::Zero(), 1.0, 16, 16);
+    Model model = scanned_particles(solid, 3000, rng);
     Particles& P = model.particles;
-    P.resize(3000);
-    P.half_size.assign(P.size(), Vec2(0.25, 0.25));
     const double c0 = std::sqrt(solid.p_wave_modulus() / kDensity);
-    for (std::size_t p = 0; p < P.size(); ++p) {
-      P.position[p] = Vec2(where(rng), where(rng));
-      const double shear = p % 3 == 0 ? 0.0 : 0.4 * where(rng) - 1.6;
-      P.deformation_gradient[p] =
-          rotation(where(rng)) * simple_shear(shear) * mpmvv::testing::random_deformation(rng, 0.3, 0.4);
-      P.velocity[p] = (p % 5 == 0 ? 2.0 : 0.1) * c0 * Vec2(unit(rng), unit(rng));
-      P.reference_volume[p] = 0.25;
-      P.volume[p] = mpmvv::determinant(P.deformation_gradient[p]) * P.reference_volume[p];
-      P.mass[p] = kDensity * P.reference_volume[p];
-      P.stress[p] = solid.cauchy_stress(P.deformation_gradient[p]);
-    }
     const CpdiShape shape = CpdiShape::bind(model.grid, P);
     const mpmvv::ParticleScan bounded = mpmvv::scan_particles(shape, solid, P, model.grid.h);
     const mpmvv::ParticleScan full = mpmvv::scan_particles(shape, WithoutBound{solid}, P, model.grid.h);
@@ -478,34 +488,17 @@ TEST(StableStep, TheScansEarlyTestLeavesTheLargestSpeedAsItIs) {
 // infinite stress or a turned-over F, at three largest speeds.
 TEST(StableStep, TheLanesScreenRulesOutWhatTheScalarTestDoes) {
   std::mt19937 rng(23);
-  std::uniform_real_distribution<double> where(4.0, 12.0), unit(-1.0, 1.0);
   const NeoHookean solid{576923.0769230769, 384615.3846153846};
-  Model model;
-  model.grid = GridGeometry::walled(Vec2::Zero(), 1.0, 16, 16);
+  Model model = scanned_particles(solid, 4000, rng);
   Particles& P = model.particles;
-  P.resize(4000);
-  P.half_size.assign(P.size(), Vec2(0.25, 0.25));
-  const double c0 = std::sqrt(solid.p_wave_modulus() / kDensity);
   for (std::size_t p = 0; p < P.size(); ++p) {
-    P.position[p] = Vec2(where(rng), where(rng));
-    const double shear = p % 3 == 0 ? 0.0 : 0.4 * where(rng) - 1.6;
-    P.deformation_gradient[p] =
-        rotation(where(rng)) * simple_shear(shear) * mpmvv::testing::random_deformation(rng, 0.3, 0.4);
-    P.velocity[p] = (p % 5 == 0 ? 2.0 : 0.1) * c0 * Vec2(unit(rng), unit(rng));
-    P.reference_volume[p] = 0.25;
-    P.volume[p] = mpmvv::determinant(P.deformation_gradient[p]) * P.reference_volume[p];
-    P.mass[p] = kDensity * P.reference_volume[p];
-    P.stress[p] = solid.cauchy_stress(P.deformation_gradient[p]);
     if (p % 97 == 1) P.velocity[p].x() = std::nan("");
     if (p % 89 == 2) P.stress[p](1, 0) = std::numeric_limits<double>::infinity();
     if (p % 83 == 3) P.deformation_gradient[p].col(0) *= -1.0;
   }
   const CpdiShape shape = CpdiShape::bind(model.grid, P);
   const double largest_speed = mpmvv::scan_particles(shape, WithoutBound{solid}, P, model.grid.h).max_signal_speed;
-  std::vector<mpmvv::LaneBuild> builds;
-  for (auto b : {mpmvv::LaneBuild::baseline, mpmvv::LaneBuild::avx2, mpmvv::LaneBuild::avx512})
-    if (mpmvv::cpu_has(b)) builds.push_back(b);
-  for (const mpmvv::LaneBuild build : builds) {
+  for (const mpmvv::LaneBuild build : mpmvv::testing::lane_builds_of_this_cpu()) {
     SCOPED_TRACE(mpmvv::name(build));
     std::size_t ruled_out = 0, formed = 0, unsound = 0;
     for (const double fraction : {0.3, 0.7, 1.0}) {
