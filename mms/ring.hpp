@@ -238,7 +238,7 @@ class RingClosedFormField final : public ForceField {
 
   // The turned angles' sines and cosines a block of points at a time from
   // the lanes (solver/lane_math.hpp; libm's scalar sincos was more than half of
-  // this function), within 2 units in the last place: the force differs from
+  // this function), within one unit in the last place: the force differs from
   // the scalar formula above in its last bits only.
   void evaluate(double t, std::vector<Vec2>& b) const override {
     constexpr std::size_t kBlock = 256;

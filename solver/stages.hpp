@@ -238,13 +238,10 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
       }
       return true;
     };
-    if constexpr (scanning) {
-      for_each_stencil(shape, range.first, n, true, usable, map, [&](std::size_t first, int count, const auto& batch) {
-        scan->screen_lanes(first, count, batch, max_speed, screen);
-      });
-    } else {
-      for_each_stencil(shape, range.first, n, false, usable, map);
-    }
+    for_each_stencil(shape, range.first, n, scanning, usable, map,
+                     [&](std::size_t first, int count, const auto& batch) {
+                       if constexpr (scanning) scan->screen_lanes(first, count, batch, max_speed, screen);
+                     });
     if constexpr (scanning) {
       // A largest and a lowest: the same whatever order the threads come in.
 #pragma omp critical

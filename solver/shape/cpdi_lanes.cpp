@@ -36,8 +36,8 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
   if (g.test_box) {
     // CpdiShapeT::inside: the corners' bounding box in grid coordinates, in
     // [0, cells] along both axes (inside_cells); NaN fails.
-    const Lanes reach_x = (s00 < zero ? -s00 : s00) + (s01 < zero ? -s01 : s01);
-    const Lanes reach_y = (s10 < zero ? -s10 : s10) + (s11 < zero ? -s11 : s11);
+    const Lanes reach_x = lane_abs(s00) + lane_abs(s01);
+    const Lanes reach_y = lane_abs(s10) + lane_abs(s11);
     const Lanes low_x = (x - reach_x - g.origin_x) / g.h, low_y = (y - reach_y - g.origin_y) / g.h;
     const Lanes high_x = (x + reach_x - g.origin_x) / g.h, high_y = (y + reach_y - g.origin_y) / g.h;
     const double cells_x = g.cells_x, cells_y = g.cells_y;
@@ -100,7 +100,7 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
       store(out.weight[a + 3 * b] + l0, w);
       store(out.gradient_x[a + 3 * b] + l0, gsx);
       store(out.gradient_y[a + 3 * b] + l0, gsy);
-      const Lanes ax = gsx < zero ? -gsx : gsx, ay = gsy < zero ? -gsy : gsy;
+      const Lanes ax = lane_abs(gsx), ay = lane_abs(gsy);
       bound += (ax > ay ? ax : ay) + kOctagonFactor * (ax > ay ? ay : ax);
     }
   store(out.gradient_bound + l0, bound);
