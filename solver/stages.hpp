@@ -677,22 +677,11 @@ double entry_gradient_sum(const Stencil<N>& s);
 template <int N>
 double gradient_sum(const Stencil<N>& s) {
   if (s.count < N) return entry_gradient_sum(s);
-  // The nodes in the order they first appear, each with its entries' sum in
-  // the order they are listed; then the lengths, computed apart from the
-  // sum so that their square roots do not wait on one another.
+  // The nodes merged (merged_gradients); then the lengths, computed apart
+  // from the sum so that their square roots do not wait on one another.
   int node[N];
   Vec2 g[N];
-  int nodes = 0;
-  for (int k = 0; k < s.count; ++k) {
-    int j = 0;
-    while (j < nodes && node[j] != s.node[k]) ++j;
-    if (j == nodes) {
-      node[nodes] = s.node[k];
-      g[nodes++] = s.gradient[k];
-    } else {
-      g[j] += s.gradient[k];
-    }
-  }
+  const int nodes = merged_gradients(s, node, g, [](int) { return false; });
   double length[N];
   for (int j = 0; j < nodes; ++j) length[j] = g[j].norm();
   double sum = 0.0;

@@ -300,19 +300,10 @@ class StaticStepper final : public Stepper {
     Vec2 gradient[Shape::stencil_size];
     for (std::size_t p = 0; p < P.size(); ++p) {
       shape.evaluate(p, s);
-      // Merge the stencil's repeated nodes (CPDI's corners share nodes).
-      int distinct = 0;
-      for (int k = 0; k < s.count; ++k) {
-        if (s.weight[k] == 0.0 && s.gradient[k].isZero()) continue;
-        int at = 0;
-        while (at < distinct && node[at] != s.node[k]) ++at;
-        if (at == distinct) {
-          node[distinct] = s.node[k];
-          gradient[distinct++] = s.gradient[k];
-        } else {
-          gradient[at] += s.gradient[k];
-        }
-      }
+      // Merge the stencil's repeated nodes (CPDI's corners share nodes),
+      // leaving out entries that carry nothing.
+      const int distinct = merged_gradients(
+          s, node, gradient, [&](int k) { return s.weight[k] == 0.0 && s.gradient[k].isZero(); });
       const double V = P.volume[p];
       for (int a = 0; a < distinct; ++a)
         for (int b = 0; b < distinct; ++b) {

@@ -41,6 +41,27 @@ auto entries_of(const Stencil<N>& s) {
   };
 }
 
+// A stencil's nodes each once, in the order they first appear, with the sum
+// of its entries' gradients in the order they are listed (a stretched CPDI
+// domain lists a node once per corner that reaches it); an entry k for which
+// skip(k) holds is passed over. Returns how many nodes.
+template <int N, class Skip>
+int merged_gradients(const Stencil<N>& s, int* node, Vec2* gradient, Skip skip) {
+  int nodes = 0;
+  for (int k = 0; k < s.count; ++k) {
+    if (skip(k)) continue;
+    int j = 0;
+    while (j < nodes && node[j] != s.node[k]) ++j;
+    if (j == nodes) {
+      node[nodes] = s.node[k];
+      gradient[nodes++] = s.gradient[k];
+    } else {
+      gradient[j] += s.gradient[k];
+    }
+  }
+  return nodes;
+}
+
 // An upper bound of sum_k |G_k| over a stencil's entries as listed, without
 // a square root, entry by entry
 //   |G| <= max(|G_x|, |G_y|) + (sqrt 2 - 1) min(|G_x|, |G_y|)
