@@ -65,18 +65,12 @@ constexpr bool evaluates_lanes() {
   return false;
 }
 
-// Lane l's stencil as the shape's evaluate gives it, with an upper bound of
-// its sum_g |G_gp| (the time-step scan's; negative where the method needs
-// none): from the lane kernel's entries where the lane is listed, else from
-// evaluate.
+// Lane l's stencil as the shape's evaluate gives it, with the lane kernel's
+// upper bound of its sum_g |G_gp| (the time-step scan's; negative where the
+// method has none).
 template <class Shape>
 void list_lane(const Shape& shape, const typename Shape::LaneBatch& batch, int l, Stencil<Shape::stencil_size>& st,
                double& gradient_bound) {
-  if (!shape.lane_listed(batch, l)) {
-    shape.evaluate(batch.first + std::size_t(l), st);
-    gradient_bound = entry_gradient_sum_bound(st);
-    return;
-  }
   int n = 0;
   shape.for_each_lane_entry(batch, l, [&](int node, double w, const Vec2& gradient) {
     st.node[n] = node;
@@ -94,17 +88,17 @@ void list_lane(const Shape& shape, const typename Shape::LaneBatch& batch, int l
 // where entries(f) passes each entry to f(node, S_gp, G_gp, <S_g / r>_p),
 // stencil_of() gives the stencil itself and gradient_bound is the lane
 // kernel's bound of sum_g |G_gp| (negative where there is none). A shape that
-// evaluates by lanes gives eight stencils at a time, its entries as they
-// stand, listed as a stencil only where stencil_of is called (the scan, where
-// its bounds do not settle a speed). usable(p, inside) is asked first, with
+// evaluates by lanes gives eight stencils at a time, its entries as the
+// kernel left them, listed as a stencil only where stencil_of is called (the
+// scan, where its bounds do not settle a speed). usable(p, inside) is asked first, with
 // the shape's test of the particle's domain in the grid (from the lanes'
-// own values where `test_box`); a particle it refuses is skipped. With lanes,
+// own values where `for_scan`, as are the bounds); a particle it refuses is skipped. With lanes,
 // `on_lanes(first, count, batch)` sees each batch before its particles are
 // visited. Ends with the threads' barrier.
 struct NoLaneHook {};
 
 template <class Shape, class Usable, class Visit, class OnLanes = NoLaneHook>
-void for_each_stencil(const Shape& shape, std::size_t begin, std::size_t end, bool test_box, Usable usable,
+void for_each_stencil(const Shape& shape, std::size_t begin, std::size_t end, bool for_scan, Usable usable,
                       Visit visit, OnLanes on_lanes = {}) {
   Stencil<Shape::stencil_size> s;
   auto stencil_s = [&]() -> const Stencil<Shape::stencil_size>& { return s; };
@@ -113,25 +107,20 @@ void for_each_stencil(const Shape& shape, std::size_t begin, std::size_t end, bo
     typename Shape::LaneBatch batch;
     for (std::size_t p0 = first; p0 < last; p0 += kLanes) {
       const int count = int(std::min<std::size_t>(kLanes, last - p0));
-      shape.compute_lanes(p0, count, batch, test_box);
+      shape.compute_lanes(p0, count, batch, for_scan);
       if constexpr (!std::is_same_v<OnLanes, NoLaneHook>) on_lanes(p0, count, batch);
       for (int l = 0; l < count; ++l) {
         const std::size_t p = p0 + std::size_t(l);
         if (!usable(p, [&] { return shape.lane_inside(batch, l); })) continue;
-        if (shape.lane_listed(batch, l)) {
-          bool listed = false;
-          auto stencil_of = [&]() -> const Stencil<Shape::stencil_size>& {
-            double bound;
-            if (!listed) list_lane(shape, batch, l, s, bound);
-            listed = true;
-            return s;
-          };
-          visit(p, [&](auto&& f) { shape.for_each_lane_entry(batch, l, f); }, stencil_of,
-                shape.lane_gradient_bound(batch, l));
-        } else {
-          shape.evaluate(p, s);
-          visit(p, entries_of(s), stencil_s, -1.0);
-        }
+        bool listed = false;
+        auto stencil_of = [&]() -> const Stencil<Shape::stencil_size>& {
+          double bound;
+          if (!listed) list_lane(shape, batch, l, s, bound);
+          listed = true;
+          return s;
+        };
+        visit(p, [&](auto&& f) { shape.for_each_lane_entry(batch, l, f); }, stencil_of,
+              shape.lane_gradient_bound(batch, l));
       }
     }
 #pragma omp barrier
@@ -891,7 +880,7 @@ struct ScanInMap {
         in.s10[l] = sigma(1, 0);
         in.s01[l] = sigma(0, 1);
         in.s11[l] = sigma(1, 1);
-        in.gradient_bound[l] = shape.lane_listed(batch, k) ? shape.lane_gradient_bound(batch, k) : -1.0;
+        in.gradient_bound[l] = shape.lane_gradient_bound(batch, k);
       }
       neo_hookean_scan_lanes(params, in, screen.verdict);
       screen.first = first;

@@ -290,21 +290,21 @@ struct CpdiShapeT {
 
   // Eight particles' stencils in two steps: compute_lanes runs the kernel on
   // particles first, ..., first + count - 1 (count at most kLanes), then
-  // for_each_lane_entry gives lane l's entries as evaluate lists them, where
-  // lane_listed, and lane_gradient_bound an upper bound of their sum_g
-  // |G_gp| (the time-step scan's; stages.hpp: signal_speed, and list_lane
-  // for the entries as a stencil). In between, lane_inside is `inside` of the lane's
+  // for_each_lane_entry gives lane l's entries as evaluate lists them, and
+  // lane_gradient_bound an upper bound of their sum_g |G_gp| (the time-step
+  // scan's, negative where there is none; stages.hpp: signal_speed, and
+  // list_lane for the entries as a stencil). In between, lane_inside is `inside` of the lane's
   // particle from the kernel's values, for the scan's health test: a
   // particle that fails it is not listed (its domain may leave the grid).
-  // `test_box` asks the kernel for what lane_inside needs (the time-step
-  // scan), `build` for a build of the kernel (tests; by default the widest
+  // `for_scan` asks the kernel for what lane_inside and lane_gradient_bound
+  // need (the time-step scan), `build` for a build of the kernel (tests; by default the widest
   // the CPU has).
   struct LaneBatch {
     std::size_t first;
     CpdiLaneStencils out;
   };
 
-  void compute_lanes(std::size_t first, int count, LaneBatch& batch, bool test_box = true,
+  void compute_lanes(std::size_t first, int count, LaneBatch& batch, bool for_scan = true,
                      const LaneBuild* build = nullptr) const
     requires lanes
   {
@@ -322,34 +322,38 @@ struct CpdiShapeT {
     }
     batch.first = first;
     const CpdiLaneGrid lane_grid{g.origin.x(), g.origin.y(), g.h, g.cells_x, g.cells_y, gradient_scale, weight_skew,
-                                 test_box};
+                                 for_scan};
     if (build) cpdi_lane_stencils(*build, lane_grid, in, batch.out);
     else cpdi_lane_stencils(lane_grid, in, batch.out);
   }
 
   bool lane_inside(const LaneBatch& batch, int l) const
     requires lanes
-  {  // the batch computed with test_box
+  {  // the batch computed for_scan
     return inside_walls(*grid, position[batch.first + std::size_t(l)]) && batch.out.box_inside[l] != 0;
   }
 
-  // True where lane l's stencil is the kernel's; a lane whose corners span
-  // more than 2 x 2 cells is left to evaluate.
-  bool lane_listed(const LaneBatch& batch, int l) const
-    requires lanes
-  {
-    return batch.out.span_i[l] <= 1 && batch.out.span_j[l] <= 1;
-  }
-
-  // Lane l's entries as evaluate lists them (the lane listed), each passed
-  // to f(node, S_gp, G_gp) in turn without a stencil between: a stencil
-  // written and read back at once stalls on its stores.
+  // Lane l's entries as evaluate lists them, each passed to f(node, S_gp,
+  // G_gp) in turn without a stencil between: a stencil written and read back
+  // at once stalls on its stores.
   template <class F>
   void for_each_lane_entry(const LaneBatch& batch, int l, F&& f) const
     requires lanes
   {
     const CpdiLaneStencils& out = batch.out;
-    const int first = grid->node(out.i0[l], out.j0[l]), row = grid->nodes_x();
+    const int row = grid->nodes_x();
+    if (out.span_i[l] > 1 || out.span_j[l] > 1) {  // four entries per corner
+      for (int c = 0; c < 4; ++c) {
+        const int n00 = grid->node(out.corner_i[c][l], out.corner_j[c][l]);
+        const int nodes[4] = {n00, n00 + 1, n00 + row, n00 + row + 1};
+        for (int k = 0; k < 4; ++k) {
+          const int slot = 4 * c + k;
+          f(nodes[k], out.wide_weight[slot][l], Vec2(out.wide_gradient_x[slot][l], out.wide_gradient_y[slot][l]));
+        }
+      }
+      return;
+    }
+    const int first = grid->node(out.i0[l], out.j0[l]);
     for (int b = 0; b <= out.span_j[l] + 1; ++b)
       for (int a = 0; a <= out.span_i[l] + 1; ++a) {
         const int slot = a + 3 * b;

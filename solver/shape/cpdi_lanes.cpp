@@ -33,7 +33,7 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
   // s^-T = [[s11, -s10], [-s01, s00]] / det s (corner_gradients).
   const Lanes inv_det = g.gradient_scale / (s00 * s11 - s01 * s10);
   const Ints last_i = Ints{} + (g.cells_x - 1), last_j = Ints{} + (g.cells_y - 1);
-  if (g.test_box) {
+  if (g.for_scan) {
     // CpdiShapeT::inside: the corners' bounding box in grid coordinates, in
     // [0, cells] along both axes (inside_cells); NaN fails.
     const Lanes reach_x = lane_abs(s00) + lane_abs(s01);
@@ -68,8 +68,10 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
   const Ints j0 = lane_min(lane_min(cell_j[0], cell_j[1]), lane_min(cell_j[2], cell_j[3]));
   store(out.i0 + l0, i0);
   store(out.j0 + l0, j0);
-  store(out.span_i + l0, lane_max(lane_max(cell_i[0], cell_i[1]), lane_max(cell_i[2], cell_i[3])) - i0);
-  store(out.span_j + l0, lane_max(lane_max(cell_j[0], cell_j[1]), lane_max(cell_j[2], cell_j[3])) - j0);
+  const Ints span_i = lane_max(lane_max(cell_i[0], cell_i[1]), lane_max(cell_i[2], cell_i[3])) - i0;
+  const Ints span_j = lane_max(lane_max(cell_j[0], cell_j[1]), lane_max(cell_j[2], cell_j[3])) - j0;
+  store(out.span_i + l0, span_i);
+  store(out.span_j + l0, span_j);
 
   // Corner c's hat factors along x at the nodes i0, i0 + 1, i0 + 2: in its
   // own cell (offset 0 or 1 from i0) 1 - fx and fx, elsewhere 0; the same
@@ -100,10 +102,58 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
       store(out.weight[a + 3 * b] + l0, w);
       store(out.gradient_x[a + 3 * b] + l0, gsx);
       store(out.gradient_y[a + 3 * b] + l0, gsy);
-      const Lanes ax = lane_abs(gsx), ay = lane_abs(gsy);
-      bound += (ax > ay ? ax : ay) + kOctagonFactor * (ax > ay ? ay : ax);
+      if (g.for_scan) {
+        const Lanes ax = lane_abs(gsx), ay = lane_abs(gsy);
+        bound += (ax > ay ? ax : ay) + kOctagonFactor * (ax > ay ? ay : ax);
+      }
     }
-  store(out.gradient_bound + l0, bound);
+  const Ints wide = (span_i > 1) | (span_j > 1);
+  bool any_wide = false;
+  for (int l = 0; l < W; ++l) any_wide |= wide[l] != 0;
+  if (any_wide) {
+    // evaluate's wide branch: corner c's bilinear weights b_k at the four
+    // nodes of its cell, times its factors.
+    for (int c = 0; c < 4; ++c) {
+      const Lanes gx = 1.0 - fx[c], gy = 1.0 - fy[c];
+      const Lanes b[4] = {gx * gy, fx[c] * gy, gx * fy[c], fx[c] * fy[c]};
+      for (int k = 0; k < 4; ++k) {
+        store(out.wide_weight[4 * c + k] + l0, corner_weight[c] * b[k]);
+        store(out.wide_gradient_x[4 * c + k] + l0, grad_x[c] * b[k]);
+        store(out.wide_gradient_y[4 * c + k] + l0, grad_y[c] * b[k]);
+      }
+      store(out.corner_i[c] + l0, cell_i[c]);
+      store(out.corner_j[c] + l0, cell_j[c]);
+    }
+  }
+  if (any_wide && g.for_scan) {
+    // The bound over the 4 x 4 nodes from (i0, j0), as above: corner c's hat
+    // factors are 1 - f at its cell's offset from i0 and f at the next.
+    Lanes wide_x[4][4], wide_y[4][4];
+    for (int c = 0; c < 4; ++c) {
+      const Lanes off_x = __builtin_convertvector(cell_i[c] - i0, Lanes);
+      const Lanes off_y = __builtin_convertvector(cell_j[c] - j0, Lanes);
+      const Lanes gx = 1.0 - fx[c], gy = 1.0 - fy[c];
+      for (int a = 0; a < 4; ++a) {
+        wide_x[c][a] = off_x == double(a) ? gx : (off_x == double(a - 1) ? fx[c] : zero);
+        wide_y[c][a] = off_y == double(a) ? gy : (off_y == double(a - 1) ? fy[c] : zero);
+      }
+    }
+    Lanes wide_bound = zero;
+    for (int b = 0; b < 4; ++b)
+      for (int a = 0; a < 4; ++a) {
+        Lanes gsx = zero, gsy = zero;
+        for (int c = 0; c < 4; ++c) {
+          const Lanes share = wide_x[c][a] * wide_y[c][b];
+          gsx += grad_x[c] * share;
+          gsy += grad_y[c] * share;
+        }
+        const Lanes ax = lane_abs(gsx), ay = lane_abs(gsy);
+        wide_bound += (ax > ay ? ax : ay) + kOctagonFactor * (ax > ay ? ay : ax);
+      }
+    const Mask within = __builtin_convertvector((span_i <= 2) & (span_j <= 2), Mask);
+    bound = __builtin_convertvector(wide, Mask) ? (within ? wide_bound : -1.0 + zero) : bound;
+  }
+  store(out.gradient_bound + l0, g.for_scan ? bound : zero - 1.0);
 }
 
 }  // namespace

@@ -19,7 +19,7 @@
 // kernel's own `box_inside` before it lists the stencil.
 //
 // A lane whose corners span more than 2 x 2 cells (a domain stretched past a
-// cell) is marked by its span and left to evaluate.
+// cell) takes evaluate's other form: four entries per corner, not merged.
 #pragma once
 
 #include "../lanes.hpp"
@@ -32,7 +32,8 @@ struct CpdiLaneGrid {
   int cells_x, cells_y;        // ghost layers included
   double gradient_scale;       // CpdiShapeT::gradient_scale
   double weight_skew;          // CpdiShapeT::weight_skew
-  bool test_box;               // fill CpdiLaneStencils::box_inside (four divisions a lane)
+  bool for_scan;               // the time-step scan reads the batch: fill box_inside (four divisions
+                               // a lane) and gradient_bound, else -1 there
 };
 
 // Each lane's centre x_p and domain s_p = [r_1 r_2] (eq. 1.97).
@@ -46,17 +47,31 @@ struct CpdiLaneInput {
 };
 
 // S_gp and G_gp of node (i0 + a, j0 + b) in slot a + 3 b, and the spans of
-// the corners' cells: a lane with a span over 1 holds no stencil.
-// `gradient_bound` is an upper bound of sum_g |G_gp| over the nine, for the
-// time-step scan (stages.hpp: entry_gradient_sum_bound, the same bound).
+// the corners' cells. `gradient_bound` is an upper bound of sum_g |G_gp|
+// over the nine, for the time-step scan (stages.hpp:
+// entry_gradient_sum_bound, the same bound), where CpdiLaneGrid::for_scan.
+//
+// A lane with a span over 1 is `wide`: its entries are evaluate's sixteen,
+// corner c's in slots 4 c + k, at the nodes (i, j), (i + 1, j), (i, j + 1),
+// (i + 1, j + 1) of the corner's cell (corner_i, corner_j), and its
+// gradient_bound is the octagon bound over the nodes they reach, each node's
+// entries summed in the order merged_gradients sums them (stencil.hpp), so
+// it bounds the scan's stiffening (stages.hpp: gradient_sum) and not the
+// looser sum over entries; -1 (none) where a span is over 2. The wide
+// arrays are filled only for batches of W lanes that hold a wide one.
 struct CpdiLaneStencils {
   alignas(64) double weight[9][kLanes];
   alignas(64) double gradient_x[9][kLanes];
   alignas(64) double gradient_y[9][kLanes];
   alignas(64) double gradient_bound[kLanes];
+  alignas(64) double wide_weight[16][kLanes];
+  alignas(64) double wide_gradient_x[16][kLanes];
+  alignas(64) double wide_gradient_y[16][kLanes];
+  alignas(32) int corner_i[4][kLanes];
+  alignas(32) int corner_j[4][kLanes];
   // The domain's bounding box, x_p -+ (|r_1| + |r_2|) along each axis, lies
   // in the grid's cells (CpdiShapeT::inside without its test of the centre);
-  // only where CpdiLaneGrid::test_box asks for it.
+  // only where CpdiLaneGrid::for_scan asks for it.
   alignas(32) int box_inside[kLanes];
   alignas(32) int i0[kLanes];
   alignas(32) int j0[kLanes];

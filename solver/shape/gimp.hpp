@@ -142,7 +142,7 @@ struct GimpShapeT {
     GimpLaneStencils out;
   };
 
-  void compute_lanes(std::size_t first, int count, LaneBatch& batch, bool /*test_box*/ = true,
+  void compute_lanes(std::size_t first, int count, LaneBatch& batch, bool /*for_scan*/ = true,
                      const LaneBuild* build = nullptr) const
     requires lanes
   {
@@ -169,12 +169,6 @@ struct GimpShapeT {
 
   // Lane l's entries as evaluate lists them, each passed to f(node, S_gp,
   // G_gp) in turn (as for CPDI, cpdi.hpp: for_each_lane_entry).
-  bool lane_listed(const LaneBatch&, int) const
-    requires lanes
-  {
-    return true;
-  }
-
   template <class F>
   void for_each_lane_entry(const LaneBatch& batch, int l, F&& f) const
     requires lanes
