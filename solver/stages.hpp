@@ -90,11 +90,11 @@ void list_lane(const Shape& shape, const typename Shape::LaneBatch& batch, int l
 // kernel's bound of sum_g |G_gp| (negative where there is none). A shape that
 // evaluates by lanes gives eight stencils at a time, its entries as the
 // kernel left them, listed as a stencil only where stencil_of is called (the
-// scan, where its bounds do not settle a speed). usable(p, inside) is asked first, with
-// the shape's test of the particle's domain in the grid (from the lanes'
-// own values where `for_scan`, as are the bounds); a particle it refuses is skipped. With lanes,
-// `on_lanes(first, count, batch)` sees each batch before its particles are
-// visited. Ends with the threads' barrier.
+// scan, where its bounds do not settle a speed). usable(p, inside) is asked
+// first, with the shape's test of the particle's domain in the grid (from
+// the lanes' own values where `for_scan`, as are the bounds); a particle it
+// refuses is skipped. With lanes, `on_lanes(first, count, batch)` sees each
+// batch before its particles are visited. Ends with the threads' barrier.
 struct NoLaneHook {};
 
 template <class Shape, class Usable, class Visit, class OnLanes = NoLaneHook>

@@ -482,8 +482,9 @@ TEST(StableStep, TheScansEarlyTestLeavesTheLargestSpeedAsItIs) {
 // The lanes' screen of the scan (material/neo_hookean_lanes.hpp), from every
 // build the CPU has: a particle is sound exactly where its state is finite
 // with J > 0, and ruled out exactly where the scalar test rules it out
-// (signal_speed returns 0) with the same largest speed (a domain stretched
-// past 2 x 2 cells is left to the scalar test); over sheared and
+// (signal_speed returns 0) with the same largest speed (a domain whose
+// corners reach past 4 x 4 nodes has no bound and is left to the scalar
+// test); over sheared and
 // stretched CPDI domains, fast and slow particles, and states with NaN, an
 // infinite stress or a turned-over F, at three largest speeds.
 TEST(StableStep, TheLanesScreenRulesOutWhatTheScalarTestDoes) {

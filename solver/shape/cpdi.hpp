@@ -293,12 +293,12 @@ struct CpdiShapeT {
   // for_each_lane_entry gives lane l's entries as evaluate lists them, and
   // lane_gradient_bound an upper bound of their sum_g |G_gp| (the time-step
   // scan's, negative where there is none; stages.hpp: signal_speed, and
-  // list_lane for the entries as a stencil). In between, lane_inside is `inside` of the lane's
-  // particle from the kernel's values, for the scan's health test: a
-  // particle that fails it is not listed (its domain may leave the grid).
-  // `for_scan` asks the kernel for what lane_inside and lane_gradient_bound
-  // need (the time-step scan), `build` for a build of the kernel (tests; by default the widest
-  // the CPU has).
+  // list_lane for the entries as a stencil). In between, lane_inside is
+  // `inside` of the lane's particle from the kernel's values, for the scan's
+  // health test: a particle that fails it is not listed (its domain may
+  // leave the grid). `for_scan` asks the kernel for what lane_inside and
+  // lane_gradient_bound need (the time-step scan), `build` for a build of
+  // the kernel (tests; by default the widest the CPU has).
   struct LaneBatch {
     std::size_t first;
     CpdiLaneStencils out;

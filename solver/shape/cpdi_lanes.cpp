@@ -20,6 +20,14 @@ struct CpdiKernel {
   MPMVV_LANE_INLINE static void body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneStencils& out, int l0);
 };
 
+// |G| <= max(|G_x|, |G_y|) + (sqrt 2 - 1) min(|G_x|, |G_y|), each lane
+// (stencil.hpp: entry_gradient_sum_bound).
+template <class Lanes>
+MPMVV_LANE_INLINE Lanes octagon_length(const Lanes& gx, const Lanes& gy) {
+  const Lanes ax = lane_abs(gx), ay = lane_abs(gy);
+  return (ax > ay ? ax : ay) + kOctagonFactor * (ax > ay ? ay : ax);
+}
+
 // Lanes l0, ..., l0 + W - 1.
 template <int W>
 void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneStencils& out, int l0) {
@@ -47,7 +55,7 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
   }
 
   Ints cell_i[4], cell_j[4];
-  Lanes fx[4], fy[4], grad_x[4], grad_y[4];
+  Lanes fx[4], fy[4], hx[4], hy[4], grad_x[4], grad_y[4];  // hx = 1 - fx, hy = 1 - fy
   double corner_weight[4];
   for (int c = 0; c < 4; ++c) {
     const double xi = kCornerXi[c], eta = kCornerEta[c];
@@ -63,6 +71,8 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
     cell_j[c] = lane_min(__builtin_convertvector(cy, Ints), last_j);
     fx[c] = cx - __builtin_convertvector(cell_i[c], Lanes);
     fy[c] = cy - __builtin_convertvector(cell_j[c], Lanes);
+    hx[c] = 1.0 - fx[c];
+    hy[c] = 1.0 - fy[c];
   }
   const Ints i0 = lane_min(lane_min(cell_i[0], cell_i[1]), lane_min(cell_i[2], cell_i[3]));
   const Ints j0 = lane_min(lane_min(cell_j[0], cell_j[1]), lane_min(cell_j[2], cell_j[3]));
@@ -80,12 +90,11 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
   for (int c = 0; c < 4; ++c) {
     const Mask first_x = __builtin_convertvector(cell_i[c] - i0, Lanes) == zero;
     const Mask first_y = __builtin_convertvector(cell_j[c] - j0, Lanes) == zero;
-    const Lanes gx = 1.0 - fx[c], gy = 1.0 - fy[c];
-    along_x[c][0] = first_x ? gx : zero;
-    along_x[c][1] = first_x ? fx[c] : gx;
+    along_x[c][0] = first_x ? hx[c] : zero;
+    along_x[c][1] = first_x ? fx[c] : hx[c];
     along_x[c][2] = first_x ? zero : fx[c];
-    along_y[c][0] = first_y ? gy : zero;
-    along_y[c][1] = first_y ? fy[c] : gy;
+    along_y[c][0] = first_y ? hy[c] : zero;
+    along_y[c][1] = first_y ? fy[c] : hy[c];
     along_y[c][2] = first_y ? zero : fy[c];
   }
   // The bound of stencil.hpp's entry_gradient_sum_bound over the nine.
@@ -102,10 +111,7 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
       store(out.weight[a + 3 * b] + l0, w);
       store(out.gradient_x[a + 3 * b] + l0, gsx);
       store(out.gradient_y[a + 3 * b] + l0, gsy);
-      if (g.for_scan) {
-        const Lanes ax = lane_abs(gsx), ay = lane_abs(gsy);
-        bound += (ax > ay ? ax : ay) + kOctagonFactor * (ax > ay ? ay : ax);
-      }
+      if (g.for_scan) bound += octagon_length(gsx, gsy);
     }
   const Ints wide = (span_i > 1) | (span_j > 1);
   bool any_wide = false;
@@ -114,8 +120,7 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
     // evaluate's wide branch: corner c's bilinear weights b_k at the four
     // nodes of its cell, times its factors.
     for (int c = 0; c < 4; ++c) {
-      const Lanes gx = 1.0 - fx[c], gy = 1.0 - fy[c];
-      const Lanes b[4] = {gx * gy, fx[c] * gy, gx * fy[c], fx[c] * fy[c]};
+      const Lanes b[4] = {hx[c] * hy[c], fx[c] * hy[c], hx[c] * fy[c], fx[c] * fy[c]};
       for (int k = 0; k < 4; ++k) {
         store(out.wide_weight[4 * c + k] + l0, corner_weight[c] * b[k]);
         store(out.wide_gradient_x[4 * c + k] + l0, grad_x[c] * b[k]);
@@ -132,10 +137,9 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
     for (int c = 0; c < 4; ++c) {
       const Lanes off_x = __builtin_convertvector(cell_i[c] - i0, Lanes);
       const Lanes off_y = __builtin_convertvector(cell_j[c] - j0, Lanes);
-      const Lanes gx = 1.0 - fx[c], gy = 1.0 - fy[c];
       for (int a = 0; a < 4; ++a) {
-        wide_x[c][a] = off_x == double(a) ? gx : (off_x == double(a - 1) ? fx[c] : zero);
-        wide_y[c][a] = off_y == double(a) ? gy : (off_y == double(a - 1) ? fy[c] : zero);
+        wide_x[c][a] = off_x == double(a) ? hx[c] : (off_x == double(a - 1) ? fx[c] : zero);
+        wide_y[c][a] = off_y == double(a) ? hy[c] : (off_y == double(a - 1) ? fy[c] : zero);
       }
     }
     Lanes wide_bound = zero;
@@ -147,8 +151,7 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
           gsx += grad_x[c] * share;
           gsy += grad_y[c] * share;
         }
-        const Lanes ax = lane_abs(gsx), ay = lane_abs(gsy);
-        wide_bound += (ax > ay ? ax : ay) + kOctagonFactor * (ax > ay ? ay : ax);
+        wide_bound += octagon_length(gsx, gsy);
       }
     const Mask within = __builtin_convertvector((span_i <= 2) & (span_j <= 2), Mask);
     bound = __builtin_convertvector(wide, Mask) ? (within ? wide_bound : -1.0 + zero) : bound;
