@@ -65,12 +65,10 @@ constexpr bool evaluates_lanes() {
   return false;
 }
 
-// Lane l's stencil as the shape's evaluate gives it, with the lane kernel's
-// upper bound of its sum_g |G_gp| (the time-step scan's; negative where the
-// method has none).
+// Lane l's stencil as the shape's evaluate gives it (the kernel's bound of
+// its sum_g |G_gp| is the shape's lane_gradient_bound).
 template <class Shape>
-void list_lane(const Shape& shape, const typename Shape::LaneBatch& batch, int l, Stencil<Shape::stencil_size>& st,
-               double& gradient_bound) {
+void list_lane(const Shape& shape, const typename Shape::LaneBatch& batch, int l, Stencil<Shape::stencil_size>& st) {
   int n = 0;
   shape.for_each_lane_entry(batch, l, [&](int node, double w, const Vec2& gradient) {
     st.node[n] = node;
@@ -79,7 +77,6 @@ void list_lane(const Shape& shape, const typename Shape::LaneBatch& batch, int l
     ++n;
   });
   st.count = n;
-  gradient_bound = shape.lane_gradient_bound(batch, l);
 }
 
 // Called by every thread of a parallel region: each particle of [begin, end)
@@ -114,8 +111,7 @@ void for_each_stencil(const Shape& shape, std::size_t begin, std::size_t end, bo
         if (!usable(p, [&] { return shape.lane_inside(batch, l); })) continue;
         bool listed = false;
         auto stencil_of = [&]() -> const Stencil<Shape::stencil_size>& {
-          double bound;
-          if (!listed) list_lane(shape, batch, l, s, bound);
+          if (!listed) list_lane(shape, batch, l, s);
           listed = true;
           return s;
         };

@@ -76,8 +76,8 @@ std::size_t expect_lanes_equal_evaluate(const Shape& shape, std::size_t n, LaneB
       // The scan's test of the domain, from the kernel's values.
       EXPECT_EQ(shape.lane_inside(batch, l), shape.inside(p)) << "particle " << p;
       Stencil<N> lane;
-      double bound = -2.0;
-      mpmvv::list_lane(shape, batch, l, lane, bound);
+      mpmvv::list_lane(shape, batch, l, lane);
+      const double bound = shape.lane_gradient_bound(batch, l);
       if (!shape.inside(p)) {  // its stencil may leave the grid: never listed in a run
         ++outside;
         continue;
