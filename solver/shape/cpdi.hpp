@@ -321,8 +321,11 @@ struct CpdiShapeT {
       in.s11[l] = s(1, 1);
     }
     batch.first = first;
-    const CpdiLaneGrid lane_grid{g.origin.x(), g.origin.y(), g.h, g.cells_x, g.cells_y, gradient_scale, weight_skew,
-                                 for_scan};
+    const Vec2 wall_lower = g.wall_lower(), wall_upper = g.wall_upper();
+    const CpdiLaneGrid lane_grid{g.origin.x(),   g.origin.y(),   g.h,
+                                 g.cells_x,      g.cells_y,      gradient_scale,
+                                 weight_skew,    wall_lower.x(), wall_lower.y(),
+                                 wall_upper.x(), wall_upper.y(), for_scan};
     if (build) cpdi_lane_stencils(*build, lane_grid, in, batch.out);
     else cpdi_lane_stencils(lane_grid, in, batch.out);
   }
@@ -330,7 +333,7 @@ struct CpdiShapeT {
   bool lane_inside(const LaneBatch& batch, int l) const
     requires lanes
   {  // the batch computed for_scan
-    return inside_walls(*grid, position[batch.first + std::size_t(l)]) && batch.out.box_inside[l] != 0;
+    return batch.out.inside[l] != 0;
   }
 
   // Lane l's entries as evaluate lists them, each passed to f(node, S_gp,

@@ -42,16 +42,18 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
   const Lanes inv_det = g.gradient_scale / (s00 * s11 - s01 * s10);
   const Ints last_i = Ints{} + (g.cells_x - 1), last_j = Ints{} + (g.cells_y - 1);
   if (g.for_scan) {
-    // CpdiShapeT::inside: the corners' bounding box in grid coordinates, in
-    // [0, cells] along both axes (inside_cells); NaN fails.
+    // CpdiShapeT::inside: the centre between the walls (inside_walls) and
+    // the corners' bounding box in grid coordinates in [0, cells] along both
+    // axes (inside_cells); NaN fails.
+    const Mask centre = (x >= g.wall_lower_x) & (x <= g.wall_upper_x) & (y >= g.wall_lower_y) & (y <= g.wall_upper_y);
     const Lanes reach_x = lane_abs(s00) + lane_abs(s01);
     const Lanes reach_y = lane_abs(s10) + lane_abs(s11);
     const Lanes low_x = (x - reach_x - g.origin_x) / g.h, low_y = (y - reach_y - g.origin_y) / g.h;
     const Lanes high_x = (x + reach_x - g.origin_x) / g.h, high_y = (y + reach_y - g.origin_y) / g.h;
     const double cells_x = g.cells_x, cells_y = g.cells_y;
-    const Mask inside = (low_x >= 0.0) & (low_x <= cells_x) & (low_y >= 0.0) & (low_y <= cells_y) &
+    const Mask inside = centre & (low_x >= 0.0) & (low_x <= cells_x) & (low_y >= 0.0) & (low_y <= cells_y) &
                         (high_x >= 0.0) & (high_x <= cells_x) & (high_y >= 0.0) & (high_y <= cells_y);
-    store(out.box_inside + l0, __builtin_convertvector(inside, Ints));
+    store(out.inside + l0, __builtin_convertvector(inside, Ints));
   }
 
   Ints cell_i[4], cell_j[4];

@@ -16,7 +16,7 @@
 //
 // The kernel reads no memory by a lane's values, so a lane may hold any
 // state, NaN included: the caller tests the particle's health with the
-// kernel's own `box_inside` before it lists the stencil.
+// kernel's own `inside` before it lists the stencil.
 //
 // A lane whose corners span more than 2 x 2 cells (a domain stretched past a
 // cell) takes evaluate's other form: four entries per corner, not merged.
@@ -32,7 +32,8 @@ struct CpdiLaneGrid {
   int cells_x, cells_y;        // ghost layers included
   double gradient_scale;       // CpdiShapeT::gradient_scale
   double weight_skew;          // CpdiShapeT::weight_skew
-  bool for_scan;               // the time-step scan reads the batch: fill box_inside (four divisions
+  double wall_lower_x, wall_lower_y, wall_upper_x, wall_upper_y;  // GridGeometry::wall_lower, wall_upper
+  bool for_scan;               // the time-step scan reads the batch: fill inside (four divisions
                                // a lane) and gradient_bound, else -1 there
 };
 
@@ -69,10 +70,10 @@ struct CpdiLaneStencils {
   alignas(64) double wide_gradient_y[16][kLanes];
   alignas(32) int corner_i[4][kLanes];
   alignas(32) int corner_j[4][kLanes];
-  // The domain's bounding box, x_p -+ (|r_1| + |r_2|) along each axis, lies
-  // in the grid's cells (CpdiShapeT::inside without its test of the centre);
-  // only where CpdiLaneGrid::for_scan asks for it.
-  alignas(32) int box_inside[kLanes];
+  // CpdiShapeT::inside: the centre lies between the walls and the domain's
+  // bounding box, x_p -+ (|r_1| + |r_2|) along each axis, in the grid's
+  // cells; only where CpdiLaneGrid::for_scan asks for it.
+  alignas(32) int inside[kLanes];
   alignas(32) int i0[kLanes];
   alignas(32) int j0[kLanes];
   alignas(32) int span_i[kLanes];

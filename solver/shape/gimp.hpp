@@ -156,7 +156,10 @@ struct GimpShapeT {
       in.ly[l] = half_size[p].y();
     }
     batch.first = first;
-    const GimpLaneGrid lane_grid{g.origin.x(), g.origin.y(), g.h, g.cells_x, g.cells_y};
+    const Vec2 wall_lower = g.wall_lower(), wall_upper = g.wall_upper(), upper = g.upper();
+    const GimpLaneGrid lane_grid{g.origin.x(),   g.origin.y(),   g.h,            g.cells_x,      g.cells_y,
+                                 wall_lower.x(), wall_lower.y(), wall_upper.x(), wall_upper.y(), upper.x(),
+                                 upper.y()};
     if (build) gimp_lane_stencils(*build, lane_grid, in, batch.out);
     else gimp_lane_stencils(lane_grid, in, batch.out);
   }
@@ -164,7 +167,7 @@ struct GimpShapeT {
   bool lane_inside(const LaneBatch& batch, int l) const
     requires lanes
   {
-    return inside(batch.first + std::size_t(l));
+    return batch.out.inside[l] != 0;
   }
 
   // Lane l's entries as evaluate lists them, each passed to f(node, S_gp,

@@ -56,6 +56,11 @@ void GimpKernel::body(const GimpLaneGrid& g, const GimpLaneInput& in, GimpLaneSt
   const Ints none = {};
   const Lanes x = load<Lanes>(in.x + l0), y = load<Lanes>(in.y + l0);
   const Lanes lx = load<Lanes>(in.lx + l0), ly = load<Lanes>(in.ly + l0);
+  // inside: the centre between the walls and the domain in the grid; NaN fails.
+  const Mask inside = (x >= g.wall_lower_x) & (x <= g.wall_upper_x) & (y >= g.wall_lower_y) &
+                      (y <= g.wall_upper_y) & (x - lx >= g.origin_x) & (y - ly >= g.origin_y) &
+                      (x + lx <= g.upper_x) & (y + ly <= g.upper_y);
+  store(out.inside + l0, __builtin_convertvector(inside, Ints));
   const Lanes xi_x = (x - g.origin_x) / g.h, xi_y = (y - g.origin_y) / g.h;  // grid_coordinate
   // floor(xi + 0.5) - 1: truncation, less one where it rounded up.
   auto floor_int = [](const Lanes& v) {

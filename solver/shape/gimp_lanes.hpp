@@ -13,6 +13,8 @@ namespace mpmvv {
 struct GimpLaneGrid {
   double origin_x, origin_y, h;
   int cells_x, cells_y;  // ghost layers included
+  double wall_lower_x, wall_lower_y, wall_upper_x, wall_upper_y;  // GridGeometry::wall_lower, wall_upper
+  double upper_x, upper_y;                                        // GridGeometry::upper
 };
 
 // Each lane's centre x_p and half-size l_p.
@@ -30,6 +32,7 @@ struct GimpLaneStencils {
   alignas(64) double gradient_y[9][kLanes];
   alignas(32) int node_i[3][kLanes];
   alignas(32) int node_j[3][kLanes];
+  alignas(32) int inside[kLanes];  // GimpShapeT::inside, for the time-step scan's health test
 };
 
 // With the build the kernels run (lane_build), or with a given one, which
