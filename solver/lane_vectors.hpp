@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cstring>
+#include <utility>
 
 #if defined(__SSE2__)
 #include <immintrin.h>
@@ -80,6 +81,38 @@ MPMVV_LANE_INLINE V load(const double* a) {
 template <class V, class T>
 MPMVV_LANE_INLINE void store(T* a, const V& v) {
   std::memcpy(a, &v, sizeof v);
+}
+
+// Lanes of an array that holds S values per lane, one lane after another
+// (S = 2 or 4: Particles keeps x_p, v_p, F_p and sigma_p so): value c of
+// every lane in v[c], from S vectors' worth of doubles by shuffles, with no
+// copy of the particles into lanes beforehand.
+template <class V>
+MPMVV_LANE_INLINE void deinterleave(const V& a, const V& b, V& even, V& odd) {
+  constexpr std::size_t W = sizeof(V) / sizeof(double);
+  using Index = typename Width<int(W)>::Mask;
+  // Indices into the 2W values of a then b.
+  constexpr Index evens = []<std::size_t... k>(std::index_sequence<k...>) {
+    return Index{(long long)(2 * k)...};
+  }(std::make_index_sequence<W>{});
+  even = __builtin_shuffle(a, b, evens);
+  odd = __builtin_shuffle(a, b, evens + 1);
+}
+
+template <class V, int S>
+MPMVV_LANE_INLINE void load_interleaved(const double* a, V (&v)[S]) {
+  constexpr int W = int(sizeof(V) / sizeof(double));
+  static_assert(S == 2 || S == 4);
+  if constexpr (S == 2) {
+    deinterleave(load<V>(a), load<V>(a + W), v[0], v[1]);
+  } else {
+    // Values 0 and 2 of each lane, then 1 and 3; then each pair apart.
+    V even[2], odd[2];
+    deinterleave(load<V>(a), load<V>(a + W), even[0], odd[0]);
+    deinterleave(load<V>(a + 2 * W), load<V>(a + 3 * W), even[1], odd[1]);
+    deinterleave(even[0], even[1], v[0], v[2]);
+    deinterleave(odd[0], odd[1], v[1], v[3]);
+  }
 }
 
 template <class V>

@@ -830,6 +830,33 @@ ParticleScan scan_particles(const Shape& shape, const Material& material, const 
   return {max_speed, first};
 }
 
+// The screen's view of particles first, ..., first + count - 1 (count at
+// most kLanes) with their stencils' bounds: P's own arrays where the batch is
+// whole, else `copy` with the spare lanes repeating the first.
+inline NeoHookeanScanLaneInput scan_lane_input(const Particles& P, std::size_t first, int count,
+                                               const double* gradient_bound, NeoHookeanScanLaneCopy& copy) {
+  static_assert(sizeof(Vec2) == 2 * sizeof(double) && sizeof(Mat2) == 4 * sizeof(double),
+                "the lanes read the particles' arrays in place, values back to back");
+  if (count == kLanes)
+    return {P.position[first].data(),
+            P.velocity[first].data(),
+            P.deformation_gradient[first].data(),
+            P.stress[first].data(),
+            P.mass.data() + first,
+            P.volume.data() + first,
+            gradient_bound};
+  for (int l = 0; l < kLanes; ++l) {
+    const std::size_t p = first + std::size_t(l < count ? l : 0);
+    std::copy_n(P.position[p].data(), 2, copy.position + 2 * l);
+    std::copy_n(P.velocity[p].data(), 2, copy.velocity + 2 * l);
+    std::copy_n(P.deformation_gradient[p].data(), 4, copy.deformation_gradient + 4 * l);
+    std::copy_n(P.stress[p].data(), 4, copy.stress + 4 * l);
+    copy.mass[l] = P.mass[p];
+    copy.volume[l] = P.volume[p];
+  }
+  return {copy.position, copy.velocity, copy.deformation_gradient, copy.stress, copy.mass, copy.volume, gradient_bound};
+}
+
 // The same scan made by the map of the step to come (particles_to_grid), which
 // weighs the state the scan reads and evaluates every particle's stencil
 // anyway: the map tests a particle's health before it evaluates the stencil
@@ -856,28 +883,10 @@ struct ScanInMap {
     if constexpr (screens) {
       const NeoHookeanScanLaneParams params{material.lambda, material.mu, material.p_wave_modulus(), largest, h,
                                             1.0 / kGridBasisGradientBound, Shape::gradients_beyond_grid_basis};
-      NeoHookeanScanLaneInput in;
-      for (int l = 0; l < kLanes; ++l) {
-        const int k = l < count ? l : 0;  // spare lanes repeat the first
-        const std::size_t p = first + std::size_t(k);
-        const Mat2& F = P.deformation_gradient[p];
-        const Mat2& sigma = P.stress[p];
-        in.x[l] = P.position[p].x();
-        in.y[l] = P.position[p].y();
-        in.mass[l] = P.mass[p];
-        in.volume[l] = P.volume[p];
-        in.vx[l] = P.velocity[p].x();
-        in.vy[l] = P.velocity[p].y();
-        in.f00[l] = F(0, 0);
-        in.f10[l] = F(1, 0);
-        in.f01[l] = F(0, 1);
-        in.f11[l] = F(1, 1);
-        in.s00[l] = sigma(0, 0);
-        in.s10[l] = sigma(1, 0);
-        in.s01[l] = sigma(0, 1);
-        in.s11[l] = sigma(1, 1);
-        in.gradient_bound[l] = shape.lane_gradient_bound(batch, k);
-      }
+      double bounds[kLanes];
+      for (int l = 0; l < kLanes; ++l) bounds[l] = shape.lane_gradient_bound(batch, l < count ? l : 0);
+      NeoHookeanScanLaneCopy copy;
+      const NeoHookeanScanLaneInput in = scan_lane_input(P, first, count, bounds, copy);
       neo_hookean_scan_lanes(params, in, screen.verdict);
       screen.first = first;
       screen.valid = true;

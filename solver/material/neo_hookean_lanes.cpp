@@ -32,13 +32,16 @@ void NeoHookeanScanKernel::body(const Grid& g, const In& in, Out& out, int l0) {
   using Mask = typename Width<W>::Mask;
   using Ints = typename Width<W>::Ints;
   const Lanes zero = {};
-  const Lanes vx = load<Lanes>(in.vx + l0), vy = load<Lanes>(in.vy + l0);
-  const Lanes f00 = load<Lanes>(in.f00 + l0), f10 = load<Lanes>(in.f10 + l0);
-  const Lanes f01 = load<Lanes>(in.f01 + l0), f11 = load<Lanes>(in.f11 + l0);
-  const Lanes s00 = load<Lanes>(in.s00 + l0), s10 = load<Lanes>(in.s10 + l0);
-  const Lanes s01 = load<Lanes>(in.s01 + l0), s11 = load<Lanes>(in.s11 + l0);
+  Lanes x[2], velocity[2], F[4], sigma[4];
+  load_interleaved(in.position + 2 * l0, x);
+  load_interleaved(in.velocity + 2 * l0, velocity);
+  load_interleaved(in.deformation_gradient + 4 * l0, F);
+  load_interleaved(in.stress + 4 * l0, sigma);
+  const Lanes vx = velocity[0], vy = velocity[1];
+  const Lanes f00 = F[0], f10 = F[1], f01 = F[2], f11 = F[3];
+  const Lanes s00 = sigma[0], s10 = sigma[1], s01 = sigma[2], s11 = sigma[3];
   // particle_healthy: 0 x is +-0 for a finite x and NaN otherwise.
-  const Lanes finite = ((0.0 * load<Lanes>(in.x + l0) + 0.0 * load<Lanes>(in.y + l0)) + (0.0 * vx + 0.0 * vy)) +
+  const Lanes finite = ((0.0 * x[0] + 0.0 * x[1]) + (0.0 * vx + 0.0 * vy)) +
                        ((0.0 * f00 + 0.0 * f10 + 0.0 * f01 + 0.0 * f11) + (0.0 * s00 + 0.0 * s10 + 0.0 * s01 + 0.0 * s11));
   const Lanes J = f00 * f11 - f01 * f10;  // determinant(F) F_33
   const Mask sound = (finite == zero) & (J > zero);

@@ -27,24 +27,30 @@ struct NeoHookeanScanLaneParams {
   bool stiffens;               // the shape's gradients reach beyond the grid basis (k_p, stages.hpp)
 };
 
-// Each lane's particle: x_p, m_p, V_p, v_p, F_p, sigma_p (in plane strain),
-// and its stencil's bound of sum_g |G_gp| (negative where there is none).
+// The particles of the eight lanes, each array holding them one after
+// another as Particles does (its arrays read in place): x_p and v_p (two
+// values a particle), F_p and sigma_p in plane strain (four, column by
+// column), m_p, V_p, and the stencil's bound of sum_g |G_gp| (negative where
+// there is none). NeoHookeanScanLaneCopy holds them for fewer particles.
 struct NeoHookeanScanLaneInput {
-  alignas(64) double x[kLanes];
-  alignas(64) double y[kLanes];
+  const double* position;
+  const double* velocity;
+  const double* deformation_gradient;
+  const double* stress;
+  const double* mass;
+  const double* volume;
+  const double* gradient_bound;
+};
+
+// The same values for a batch of fewer than eight particles, the spare lanes
+// repeating the first (stages.hpp: scan_lane_input).
+struct NeoHookeanScanLaneCopy {
+  alignas(64) double position[2 * kLanes];
+  alignas(64) double velocity[2 * kLanes];
+  alignas(64) double deformation_gradient[4 * kLanes];
+  alignas(64) double stress[4 * kLanes];
   alignas(64) double mass[kLanes];
   alignas(64) double volume[kLanes];
-  alignas(64) double vx[kLanes];
-  alignas(64) double vy[kLanes];
-  alignas(64) double f00[kLanes];
-  alignas(64) double f10[kLanes];
-  alignas(64) double f01[kLanes];
-  alignas(64) double f11[kLanes];
-  alignas(64) double s00[kLanes];
-  alignas(64) double s10[kLanes];
-  alignas(64) double s01[kLanes];
-  alignas(64) double s11[kLanes];
-  alignas(64) double gradient_bound[kLanes];
 };
 
 // Per lane: `sound`, nonzero where the state is finite and J > 0;
