@@ -831,26 +831,26 @@ ParticleScan scan_particles(const Shape& shape, const Material& material, const 
 }
 
 // The screen's view of particles first, ..., first + count - 1 (count at
-// most kLanes) with their stencils' bounds: P's own arrays where the batch is
-// whole, else `copy` with the spare lanes repeating the first.
+// most kLanes) with their stencils' bounds (the shape's lane_gradient_bounds,
+// null where it has none: the screen reads them only for a shape that
+// stiffens): P's own arrays where the batch is whole, else `copy` with the
+// spare lanes repeating the first.
 inline NeoHookeanScanLaneInput scan_lane_input(const Particles& P, std::size_t first, int count,
                                                const double* gradient_bound, NeoHookeanScanLaneCopy& copy) {
-  static_assert(sizeof(Vec2) == 2 * sizeof(double) && sizeof(Mat2) == 4 * sizeof(double),
-                "the lanes read the particles' arrays in place, values back to back");
   if (count == kLanes)
-    return {P.position[first].data(),
-            P.velocity[first].data(),
-            P.deformation_gradient[first].data(),
-            P.stress[first].data(),
+    return {values_of(&P.position[first]),
+            values_of(&P.velocity[first]),
+            values_of(&P.deformation_gradient[first]),
+            values_of(&P.stress[first]),
             P.mass.data() + first,
             P.volume.data() + first,
             gradient_bound};
   for (int l = 0; l < kLanes; ++l) {
     const std::size_t p = first + std::size_t(l < count ? l : 0);
-    std::copy_n(P.position[p].data(), 2, copy.position + 2 * l);
-    std::copy_n(P.velocity[p].data(), 2, copy.velocity + 2 * l);
-    std::copy_n(P.deformation_gradient[p].data(), 4, copy.deformation_gradient + 4 * l);
-    std::copy_n(P.stress[p].data(), 4, copy.stress + 4 * l);
+    std::copy_n(values_of(&P.position[p]), 2, copy.position + 2 * l);
+    std::copy_n(values_of(&P.velocity[p]), 2, copy.velocity + 2 * l);
+    std::copy_n(values_of(&P.deformation_gradient[p]), 4, copy.deformation_gradient + 4 * l);
+    std::copy_n(values_of(&P.stress[p]), 4, copy.stress + 4 * l);
     copy.mass[l] = P.mass[p];
     copy.volume[l] = P.volume[p];
   }
@@ -883,10 +883,8 @@ struct ScanInMap {
     if constexpr (screens) {
       const NeoHookeanScanLaneParams params{material.lambda, material.mu, material.p_wave_modulus(), largest, h,
                                             1.0 / kGridBasisGradientBound, Shape::gradients_beyond_grid_basis};
-      double bounds[kLanes];
-      for (int l = 0; l < kLanes; ++l) bounds[l] = shape.lane_gradient_bound(batch, l < count ? l : 0);
       NeoHookeanScanLaneCopy copy;
-      const NeoHookeanScanLaneInput in = scan_lane_input(P, first, count, bounds, copy);
+      const NeoHookeanScanLaneInput in = scan_lane_input(P, first, count, shape.lane_gradient_bounds(batch), copy);
       neo_hookean_scan_lanes(params, in, screen.verdict);
       screen.first = first;
       screen.valid = true;

@@ -28,4 +28,14 @@ inline double largest_principal(const Mat2& s) {
   return mean + std::sqrt(half_diff * half_diff + s(0, 1) * s(0, 1));
 }
 
+// The doubles of an array of Vec2 or Mat2 (a Mat2 column by column), each
+// value's back to back: the lane kernels read the particles' arrays in place
+// through these (lane_vectors.hpp: load_interleaved).
+template <class T>
+const double* values_of(const T* a) {
+  static_assert(sizeof(T) == T::SizeAtCompileTime * sizeof(double) && !T::IsRowMajor,
+                "the lanes read the values back to back, a matrix column by column");
+  return a->data();
+}
+
 }  // namespace mpmvv

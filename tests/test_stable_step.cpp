@@ -510,10 +510,9 @@ TEST(StableStep, TheLanesScreenRulesOutWhatTheScalarTestDoes) {
         const int count = int(std::min<std::size_t>(mpmvv::kLanes, n - first));
         CpdiShape::LaneBatch batch;
         shape.compute_lanes(first, count, batch, true, &build);
-        double bounds[mpmvv::kLanes];
-        for (int l = 0; l < mpmvv::kLanes; ++l) bounds[l] = shape.lane_gradient_bound(batch, l < count ? l : 0);
         mpmvv::NeoHookeanScanLaneCopy copy;
-        const mpmvv::NeoHookeanScanLaneInput in = mpmvv::scan_lane_input(P, first, count, bounds, copy);
+        const mpmvv::NeoHookeanScanLaneInput in =
+            mpmvv::scan_lane_input(P, first, count, shape.lane_gradient_bounds(batch), copy);
         const mpmvv::NeoHookeanScanLaneParams params{solid.lambda, solid.mu, solid.p_wave_modulus(), largest,
                                                      model.grid.h, 1.0 / mpmvv::kGridBasisGradientBound, true};
         mpmvv::NeoHookeanScanLaneVerdict verdict;

@@ -310,15 +310,18 @@ struct CpdiShapeT {
   {
     const GridGeometry& g = *grid;
     CpdiLaneInput in;
-    for (int l = 0; l < kLanes; ++l) {
-      const std::size_t p = first + std::size_t(l < count ? l : 0);  // spare lanes repeat the first
-      const Mat2 s = domain(p);
-      in.x[l] = position[p].x();
-      in.y[l] = position[p].y();
-      in.s00[l] = s(0, 0);
-      in.s01[l] = s(0, 1);
-      in.s10[l] = s(1, 0);
-      in.s11[l] = s(1, 1);
+    CpdiLaneCopy copy;
+    if (count == kLanes && deformation_gradient && !Turned) {
+      in = {values_of(position + first), values_of(deformation_gradient + first), values_of(half_size + first)};
+    } else {
+      for (int l = 0; l < kLanes; ++l) {
+        const std::size_t p = first + std::size_t(l < count ? l : 0);  // spare lanes repeat the first
+        std::copy_n(values_of(position + p), 2, copy.position + 2 * l);
+        const Mat2 s = domain(p);
+        std::copy_n(values_of(&s), 4, copy.deformation_gradient + 4 * l);
+        std::fill_n(copy.half_size + 2 * l, 2, 1.0);
+      }
+      in = {copy.position, copy.deformation_gradient, copy.half_size};
     }
     batch.first = first;
     const Vec2 wall_lower = g.wall_lower(), wall_upper = g.wall_upper();
@@ -364,11 +367,17 @@ struct CpdiShapeT {
       }
   }
 
-  // The bound of sum_g |G_gp| the kernel gives with lane l's entries.
+  // The bound of sum_g |G_gp| the kernel gives with lane l's entries, and
+  // the eight lanes' bounds back to back (the spare lanes' the first's).
   double lane_gradient_bound(const LaneBatch& batch, int l) const
     requires lanes
   {
     return batch.out.gradient_bound[l];
+  }
+  const double* lane_gradient_bounds(const LaneBatch& batch) const
+    requires lanes
+  {
+    return batch.out.gradient_bound;
   }
 
   // A corner domain turned over, 4 det [a_1 a_2] <= 0 (monitors.hpp:

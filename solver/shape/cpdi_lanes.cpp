@@ -35,9 +35,14 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
   using Mask = typename Width<W>::Mask;
   using Ints = typename Width<W>::Ints;
   const Lanes zero = {};
-  const Lanes x = load<Lanes>(in.x + l0), y = load<Lanes>(in.y + l0);
-  const Lanes s00 = load<Lanes>(in.s00 + l0), s01 = load<Lanes>(in.s01 + l0);
-  const Lanes s10 = load<Lanes>(in.s10 + l0), s11 = load<Lanes>(in.s11 + l0);
+  Lanes position[2], F[4], half[2];
+  load_interleaved(in.position + 2 * l0, position);
+  load_interleaved(in.deformation_gradient + 4 * l0, F);
+  load_interleaved(in.half_size + 2 * l0, half);
+  const Lanes x = position[0], y = position[1];
+  // s_p = F_p diag(l_p), column by column as CpdiShapeT::domain scales it.
+  const Lanes s00 = F[0] * half[0], s10 = F[1] * half[0];
+  const Lanes s01 = F[2] * half[1], s11 = F[3] * half[1];
   // s^-T = [[s11, -s10], [-s01, s00]] / det s (corner_gradients).
   const Lanes inv_det = g.gradient_scale / (s00 * s11 - s01 * s10);
   const Ints last_i = Ints{} + (g.cells_x - 1), last_j = Ints{} + (g.cells_y - 1);

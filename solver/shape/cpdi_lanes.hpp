@@ -37,14 +37,24 @@ struct CpdiLaneGrid {
                                // a lane) and gradient_bound, else -1 there
 };
 
-// Each lane's centre x_p and domain s_p = [r_1 r_2] (eq. 1.97).
+// Eight particles' centres x_p and domains s_p = [r_1 r_2] = F_p diag(l_p)
+// (eq. 1.97), read in place: the particles' own arrays from the batch's
+// first (Particles::position, deformation_gradient column by column,
+// half_size; tensor.hpp: values_of). CpdiLaneCopy holds them otherwise.
 struct CpdiLaneInput {
-  alignas(64) double x[kLanes];
-  alignas(64) double y[kLanes];
-  alignas(64) double s00[kLanes];
-  alignas(64) double s01[kLanes];
-  alignas(64) double s10[kLanes];
-  alignas(64) double s11[kLanes];
+  const double* position;              // 2 a lane
+  const double* deformation_gradient;  // 4 a lane
+  const double* half_size;             // 2 a lane
+};
+
+// The same for a batch of fewer than eight particles (its spare lanes
+// repeating the first), or for domains of another form (turned, F_p A_p; or
+// no F_p): s_p itself in F_p's place and half sizes of 1, which the kernel's
+// products s_p l_p leave as they are, to the bit.
+struct CpdiLaneCopy {
+  alignas(64) double position[2 * kLanes];
+  alignas(64) double deformation_gradient[4 * kLanes];
+  alignas(64) double half_size[2 * kLanes];
 };
 
 // S_gp and G_gp of node (i0 + a, j0 + b) in slot a + 3 b, and the spans of

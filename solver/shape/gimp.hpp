@@ -11,6 +11,7 @@
 // in closed form below; along z the plain eqs. 1.91-1.92.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 
 #include "../particles.hpp"
@@ -147,13 +148,15 @@ struct GimpShapeT {
     requires lanes
   {
     const GridGeometry& g = *grid;
-    GimpLaneInput in;
-    for (int l = 0; l < kLanes; ++l) {
-      const std::size_t p = first + std::size_t(l < count ? l : 0);  // spare lanes repeat the first
-      in.x[l] = position[p].x();
-      in.y[l] = position[p].y();
-      in.lx[l] = half_size[p].x();
-      in.ly[l] = half_size[p].y();
+    GimpLaneInput in{values_of(position + first), values_of(half_size + first)};
+    GimpLaneCopy copy;
+    if (count < kLanes) {
+      for (int l = 0; l < kLanes; ++l) {
+        const std::size_t p = first + std::size_t(l < count ? l : 0);  // spare lanes repeat the first
+        std::copy_n(values_of(position + p), 2, copy.position + 2 * l);
+        std::copy_n(values_of(half_size + p), 2, copy.half_size + 2 * l);
+      }
+      in = {copy.position, copy.half_size};
     }
     batch.first = first;
     const Vec2 wall_lower = g.wall_lower(), wall_upper = g.wall_upper(), upper = g.upper();
@@ -190,6 +193,11 @@ struct GimpShapeT {
     requires lanes
   {
     return -1.0;
+  }
+  const double* lane_gradient_bounds(const LaneBatch&) const
+    requires lanes
+  {
+    return nullptr;
   }
 
   // The particle's centre lies between the walls and its domain inside the

@@ -54,8 +54,10 @@ void GimpKernel::body(const GimpLaneGrid& g, const GimpLaneInput& in, GimpLaneSt
   using Ints = typename Width<W>::Ints;
   const Lanes zero = {};
   const Ints none = {};
-  const Lanes x = load<Lanes>(in.x + l0), y = load<Lanes>(in.y + l0);
-  const Lanes lx = load<Lanes>(in.lx + l0), ly = load<Lanes>(in.ly + l0);
+  Lanes position[2], half[2];
+  load_interleaved(in.position + 2 * l0, position);
+  load_interleaved(in.half_size + 2 * l0, half);
+  const Lanes x = position[0], y = position[1], lx = half[0], ly = half[1];
   // inside: the centre between the walls and the domain in the grid; NaN fails.
   const Mask inside = (x >= g.wall_lower_x) & (x <= g.wall_upper_x) & (y >= g.wall_lower_y) &
                       (y <= g.wall_upper_y) & (x - lx >= g.origin_x) & (y - ly >= g.origin_y) &

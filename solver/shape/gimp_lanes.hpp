@@ -17,12 +17,17 @@ struct GimpLaneGrid {
   double upper_x, upper_y;                                        // GridGeometry::upper
 };
 
-// Each lane's centre x_p and half-size l_p.
+// Eight particles' centres x_p and half-sizes l_p, read in place: the
+// particles' own arrays from the batch's first (as for CPDI, cpdi_lanes.hpp).
 struct GimpLaneInput {
-  alignas(64) double x[kLanes];
-  alignas(64) double y[kLanes];
-  alignas(64) double lx[kLanes];
-  alignas(64) double ly[kLanes];
+  const double* position;   // 2 a lane
+  const double* half_size;  // 2 a lane
+};
+
+// The same for a batch of fewer than eight, the spare lanes repeating the first.
+struct GimpLaneCopy {
+  alignas(64) double position[2 * kLanes];
+  alignas(64) double half_size[2 * kLanes];
 };
 
 // S_gp and G_gp of node (node_i[a], node_j[b]) in slot a + 3 b.
