@@ -13,10 +13,12 @@
 // 2, 40 and 1e5: at most 0.79 units in the last place (libm: 0.52).
 #include "lane_math.hpp"
 
+#include "lane_log.hpp"
 #include "lane_vectors.hpp"
 
 #if defined(MPMVV_LANE_DISPATCH)
 #include <cmath>
+#include <limits>
 #endif
 
 namespace mpmvv {
@@ -104,6 +106,17 @@ void sincos_array(std::size_t n, const double* x, double* sin_x, double* cos_x) 
     cos_x[k + l] = ct[l];
   }
 }
+
+void log_array(std::size_t n, const double* x, double* log_x) {
+  using Lanes = Width<kWidth>::Lanes;
+  std::size_t k = 0;
+  for (; k + kWidth <= n; k += kWidth) store(log_x + k, lane_log(load<Lanes>(x + k)));
+  if (k == n) return;
+  double xt[kWidth], lt[kWidth];  // the last few through a full vector: spare lanes hold 1
+  for (std::size_t l = 0; l < std::size_t(kWidth); ++l) xt[l] = k + l < n ? x[k + l] : 1.0;
+  store(lt, lane_log(load<Lanes>(xt)));
+  for (std::size_t l = 0; k + l < n; ++l) log_x[k + l] = lt[l];
+}
 }  // namespace lanes::MPMVV_LANE_BUILD_NS
 
 #if defined(MPMVV_LANE_DISPATCH)
@@ -119,6 +132,15 @@ void lane_sincos(LaneBuild build, std::size_t n, const double* x, double* sin_x,
 void lane_sincos(std::size_t n, const double* x, double* sin_x, double* cos_x) {
   lane_sincos(lane_build(), n, x, sin_x, cos_x);
 }
+
+void lane_log(LaneBuild build, std::size_t n, const double* x, double* log_x) {
+  MPMVV_LANE_BUILD_CALL(build, log_array(n, x, log_x));
+  for (std::size_t k = 0; k < n; ++k)
+    if (!(x[k] >= std::numeric_limits<double>::min() && x[k] <= std::numeric_limits<double>::max()))
+      log_x[k] = std::log(x[k]);
+}
+
+void lane_log(std::size_t n, const double* x, double* log_x) { lane_log(lane_build(), n, x, log_x); }
 #endif
 
 }  // namespace mpmvv

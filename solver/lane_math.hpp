@@ -4,7 +4,8 @@
 //
 // Why: a body force that turns with each particle's angle calls sin and cos
 // once per particle per step (mms/ring.hpp), and libm's scalar sincos was a
-// ninth of a CPDI step's instructions on the ring.
+// ninth of a CPDI step's instructions on the ring; the neo-Hookean stress
+// takes ln J of every particle every step (material/neo_hookean_lanes.hpp).
 #pragma once
 
 #include <cstddef>
@@ -24,15 +25,24 @@ inline constexpr double kLaneSinCosLimit = 1.0e6;
 void lane_sincos(std::size_t n, const double* x, double* sin_x, double* cos_x);
 void lane_sincos(LaneBuild build, std::size_t n, const double* x, double* sin_x, double* cos_x);
 
+// ln x_k for k < n, within one unit in the last place (lane_log.hpp; the
+// same test measures it); libm's value where x_k is not positive, finite
+// and normal.
+void lane_log(std::size_t n, const double* x, double* log_x);
+void lane_log(LaneBuild build, std::size_t n, const double* x, double* log_x);
+
 // Each build's own, compiled for its instructions (solver/CMakeLists.txt).
 namespace lanes::avx512 {
 void sincos_array(std::size_t n, const double* x, double* sin_x, double* cos_x);
+void log_array(std::size_t n, const double* x, double* log_x);
 }
 namespace lanes::avx2 {
 void sincos_array(std::size_t n, const double* x, double* sin_x, double* cos_x);
+void log_array(std::size_t n, const double* x, double* log_x);
 }
 namespace lanes::baseline {
 void sincos_array(std::size_t n, const double* x, double* sin_x, double* cos_x);
+void log_array(std::size_t n, const double* x, double* log_x);
 }
 
 }  // namespace mpmvv

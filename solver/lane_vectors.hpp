@@ -48,7 +48,7 @@ namespace mpmvv::lanes::MPMVV_LANE_BUILD_NS {
 
 inline constexpr int kWidth = MPMVV_LANE_WIDTH;
 
-// W lanes of doubles, of their comparisons and of ints (one specialization
+// W lanes of doubles, of their comparisons, of ints and of the doubles' bits (one specialization
 // per width: GCC keeps a vector size only where it is not a template's).
 template <int W>
 struct Width;
@@ -57,18 +57,21 @@ struct Width<8> {
   typedef double Lanes __attribute__((vector_size(64)));
   typedef long long Mask __attribute__((vector_size(64)));
   typedef int Ints __attribute__((vector_size(32)));
+  typedef unsigned long long Bits __attribute__((vector_size(64)));  // a double's bits
 };
 template <>
 struct Width<4> {
   typedef double Lanes __attribute__((vector_size(32)));
   typedef long long Mask __attribute__((vector_size(32)));
   typedef int Ints __attribute__((vector_size(16)));
+  typedef unsigned long long Bits __attribute__((vector_size(32)));  // a double's bits
 };
 template <>
 struct Width<2> {
   typedef double Lanes __attribute__((vector_size(16)));
   typedef long long Mask __attribute__((vector_size(16)));
   typedef int Ints __attribute__((vector_size(8)));
+  typedef unsigned long long Bits __attribute__((vector_size(16)));  // a double's bits
 };
 
 template <class V>
@@ -113,6 +116,32 @@ MPMVV_LANE_INLINE void load_interleaved(const double* a, V (&v)[S]) {
     deinterleave(even[0], even[1], v[0], v[2]);
     deinterleave(odd[0], odd[1], v[1], v[3]);
   }
+}
+
+// The inverse of deinterleave: a and b hold even[0], odd[0], even[1], ...
+template <class V>
+MPMVV_LANE_INLINE void interleave(const V& even, const V& odd, V& a, V& b) {
+  constexpr std::size_t W = sizeof(V) / sizeof(double);
+  using Index = typename Width<int(W)>::Mask;
+  // Value k of the 2W in turn is even[k / 2] or odd[k / 2] (index W + k / 2).
+  constexpr Index low = []<std::size_t... k>(std::index_sequence<k...>) {
+    return Index{(long long)(k % 2 ? W + k / 2 : k / 2)...};
+  }(std::make_index_sequence<W>{});
+  a = __builtin_shuffle(even, odd, low);
+  b = __builtin_shuffle(even, odd, low + (long long)(W / 2));
+}
+
+// The inverse of load_interleaved (S = 4): value c of every lane from v[c]
+// into an array that holds four values per lane, one lane after another.
+template <class V>
+MPMVV_LANE_INLINE void store_interleaved(double* a, const V (&v)[4]) {
+  constexpr int W = int(sizeof(V) / sizeof(double));
+  V even[2], odd[2], out[4];
+  interleave(v[0], v[2], even[0], even[1]);
+  interleave(v[1], v[3], odd[0], odd[1]);
+  interleave(even[0], odd[0], out[0], out[1]);
+  interleave(even[1], odd[1], out[2], out[3]);
+  for (int k = 0; k < 4; ++k) store(a + k * W, out[k]);
 }
 
 template <class V>

@@ -9,9 +9,19 @@
 // scalar code's operations in its order.
 #pragma once
 
+#include <cstddef>
+
 namespace mpmvv {
 
 inline constexpr int kLanes = 8;
+
+// The particle lane l holds where a batch of `count` particles from `first`
+// is copied into lanes (a batch of fewer than kLanes, or one that cannot be
+// read in place): its own, and the first's in the spare lanes, so that they
+// compute what the batch's own lanes do.
+inline std::size_t copied_lane_particle(std::size_t first, int count, int l) {
+  return first + std::size_t(l < count ? l : 0);
+}
 
 enum class LaneBuild { baseline, avx2, avx512 };  // avx512: its F, DQ and VL extensions
 

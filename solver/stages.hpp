@@ -66,7 +66,7 @@ constexpr bool evaluates_lanes() {
 }
 
 // Lane l's stencil as the shape's evaluate gives it (the kernel's bound of
-// its sum_g |G_gp| is the shape's lane_gradient_bound).
+// its sum_g |G_gp| is lane l of the shape's lane_gradient_bounds).
 template <class Shape>
 void list_lane(const Shape& shape, const typename Shape::LaneBatch& batch, int l, Stencil<Shape::stencil_size>& st) {
   int n = 0;
@@ -115,8 +115,8 @@ void for_each_stencil(const Shape& shape, std::size_t begin, std::size_t end, bo
           listed = true;
           return s;
         };
-        visit(p, [&](auto&& f) { shape.for_each_lane_entry(batch, l, f); }, stencil_of,
-              shape.lane_gradient_bound(batch, l));
+        const double* bounds = shape.lane_gradient_bounds(batch);
+        visit(p, [&](auto&& f) { shape.for_each_lane_entry(batch, l, f); }, stencil_of, bounds ? bounds[l] : -1.0);
       }
     }
 #pragma omp barrier
@@ -510,6 +510,13 @@ void update_stress(const Material& material, Particles& P, std::size_t begin = 0
       P.stress[p] = sigma.in_plane;
       P.hoop_stress[p] = sigma.out_of_plane;
     }
+  } else if constexpr (requires { material.cauchy_stress_array(n, P.deformation_gradient.data(), P.stress.data()); }) {
+    // A material that forms its stresses by lanes takes each thread's block at once.
+#pragma omp parallel
+    {
+      const auto [first, last] = static_block(begin, n);
+      if (last > first) material.cauchy_stress_array(last - first, &P.deformation_gradient[first], &P.stress[first]);
+    }
   } else {
 #pragma omp parallel for schedule(static)
     for (std::size_t p = begin; p < n; ++p) P.stress[p] = material.cauchy_stress(P.deformation_gradient[p]);
@@ -846,7 +853,7 @@ inline NeoHookeanScanLaneInput scan_lane_input(const Particles& P, std::size_t f
             P.volume.data() + first,
             gradient_bound};
   for (int l = 0; l < kLanes; ++l) {
-    const std::size_t p = first + std::size_t(l < count ? l : 0);
+    const std::size_t p = copied_lane_particle(first, count, l);
     std::copy_n(values_of(&P.position[p]), 2, copy.position + 2 * l);
     std::copy_n(values_of(&P.velocity[p]), 2, copy.velocity + 2 * l);
     std::copy_n(values_of(&P.deformation_gradient[p]), 4, copy.deformation_gradient + 4 * l);

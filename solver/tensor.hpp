@@ -37,5 +37,9 @@ const double* values_of(const T* a) {
                 "the lanes read the values back to back, a matrix column by column");
   return a->data();
 }
+template <class T>
+double* values_of(T* a) {  // and write them so (neo_hookean_lanes.hpp: the stress update)
+  return const_cast<double*>(values_of(static_cast<const T*>(a)));
+}
 
 }  // namespace mpmvv

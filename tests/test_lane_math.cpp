@@ -1,6 +1,6 @@
-// The lanes' sin and cos (solver/lane_math.hpp): within one unit in the
-// last place of the exact values, the same bits from every build of the
-// kernels this CPU can run, and libm's values beyond the reduction's range.
+// The lanes' sin, cos and log (solver/lane_math.hpp): within one unit in
+// the last place of the exact values, the same bits from every build of the
+// kernels this CPU can run, and libm's values beyond the lanes' range.
 #include <gtest/gtest.h>
 
 #include "support.hpp"
@@ -120,6 +120,85 @@ TEST(LaneSinCos, BeyondTheLimitTheValuesAreLibms) {
     // And within it the lanes' own: 12.5 is reduced by 4 pi/2.
     EXPECT_LE(ulps(s.back(), std::sin(12.5L)), 1.0);
     EXPECT_LE(ulps(c.back(), std::cos(12.5L)), 1.0);
+  }
+}
+
+// Arguments of ln: random over the J a solid reaches (0.05 to 20) and over
+// every exponent, near 1 (where ln x is near zero and f - f^2/2 cancels),
+// both sides of sqrt(2) and sqrt(1/2) (where the reduction changes the
+// exponent), powers of two and the ends of the normal range.
+std::vector<double> log_arguments() {
+  std::vector<double> x;
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> solid(0.05, 20.0), exponent(-1021.0, 1023.0), near_one(-1e-3, 1e-3);
+  for (int k = 0; k < 30000; ++k) x.push_back(solid(rng));
+  for (int k = 0; k < 10000; ++k) x.push_back(std::exp2(exponent(rng)));
+  for (int k = 0; k < 10000; ++k) x.push_back(1.0 + near_one(rng));
+  for (double at : {std::sqrt(2.0), std::sqrt(0.5), 1.0, 2.0, 0.5}) {
+    double up = at, down = at;
+    for (int k = 0; k < 50; ++k) {
+      x.push_back(up);
+      x.push_back(down);
+      up = std::nextafter(up, 10.0);
+      down = std::nextafter(down, 0.0);
+    }
+  }
+  for (int e = -1022; e <= 1023; e += 7) x.push_back(std::ldexp(1.0, e));
+  x.push_back(std::numeric_limits<double>::min());
+  x.push_back(std::numeric_limits<double>::max());
+  return x;
+}
+
+// Measured largest error on this set: printed as a property.
+TEST(LaneLog, WithinOneUnitInTheLastPlace) {
+  const std::vector<double> x = log_arguments();
+  std::vector<double> l(x.size());
+  mpmvv::lane_log(x.size(), x.data(), l.data());
+  double worst = 0.0;
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    if (x[k] == 1.0) {
+      EXPECT_EQ(bits(l[k]), bits(0.0));  // ln 1 = +0 exactly
+      continue;
+    }
+    worst = std::max(worst, ulps(l[k], std::log((long double)x[k])));
+  }
+  RecordProperty("largest_log_error_ulp", std::to_string(worst));
+  EXPECT_LE(worst, 1.0);
+}
+
+TEST(LaneLog, EveryBuildAndCountGivesTheSameBits) {
+  const std::vector<double> x = log_arguments();
+  std::vector<double> l0(x.size());
+  mpmvv::lane_log(LaneBuild::baseline, x.size(), x.data(), l0.data());
+  for (LaneBuild build : mpmvv::testing::lane_builds_of_this_cpu()) {
+    SCOPED_TRACE(mpmvv::name(build));
+    std::vector<double> l(x.size());
+    mpmvv::lane_log(build, x.size(), x.data(), l.data());
+    for (std::size_t k = 0; k < x.size(); ++k) ASSERT_EQ(bits(l[k]), bits(l0[k])) << "x = " << x[k];
+    for (std::size_t count = 1; count <= 19; ++count) {
+      std::vector<double> lc(count);
+      mpmvv::lane_log(build, count, x.data() + 3, lc.data());
+      for (std::size_t k = 0; k < count; ++k) EXPECT_EQ(bits(lc[k]), bits(l0[3 + k])) << "count " << count;
+    }
+  }
+}
+
+// Zero, negative, subnormal, infinite and NaN arguments take libm's values.
+TEST(LaneLog, OutsideTheNormalRangeTheValuesAreLibms) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const std::vector<double> x = {0.0, -0.0, -1.0, 5e-324, std::numeric_limits<double>::denorm_min() * 77, inf, -inf, 3.0};
+  for (LaneBuild build : mpmvv::testing::lane_builds_of_this_cpu()) {
+    SCOPED_TRACE(mpmvv::name(build));
+    std::vector<double> l(x.size());
+    mpmvv::lane_log(build, x.size(), x.data(), l.data());
+    for (std::size_t k = 0; k + 1 < x.size(); ++k) {
+      if (std::isnan(std::log(x[k]))) {
+        EXPECT_TRUE(std::isnan(l[k])) << "x = " << x[k];
+        continue;
+      }
+      EXPECT_EQ(bits(l[k]), bits(std::log(x[k]))) << "x = " << x[k];
+    }
+    EXPECT_LE(ulps(l.back(), std::log(3.0L)), 1.0);
   }
 }
 

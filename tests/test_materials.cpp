@@ -6,11 +6,15 @@
 #include "support.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "solver/material/mooney_rivlin.hpp"
 #include "solver/material/neo_hookean.hpp"
@@ -32,6 +36,8 @@ using mpmvv::testing::simple_shear;
 
 // Random F with det F >= 0.3 and entries of order one.
 Mat2 random_deformation(std::mt19937& rng) { return mpmvv::testing::random_deformation(rng, 0.7, 0.3); }
+
+std::uint64_t bits(double x) { return std::bit_cast<std::uint64_t>(x); }
 
 std::string show(const Mat2& a) {
   std::ostringstream text;
@@ -221,6 +227,54 @@ TEST(NeoHookean, WaveModulusBoundIsAtLeastTheWaveModulus) {
     EXPECT_DOUBLE_EQ(m.wave_modulus_bound(Mat2::Identity(), 1.0, Mat2::Zero()),
                      m.wave_modulus(Mat2::Identity(), 1.0, Mat2::Zero()));
     EXPECT_LT(tightest, 1.01);
+  }
+}
+
+// The stress update in lanes (neo_hookean_lanes.hpp) against the scalar
+// stress: the same operations but for ln J, so within a few units in the
+// last place of the stress's own terms; the same bits from every build and
+// for every count (the last few through spare lanes); a J that is not
+// positive, finite and normal takes the scalar stress itself.
+TEST(NeoHookean, StressInLanesIsTheScalarStress) {
+  std::mt19937 rng(43);
+  std::vector<Mat2> F;
+  for (int k = 0; k < 5000; ++k) F.push_back(mpmvv::testing::random_deformation(rng, 1.5, 0.05));
+  F.push_back(Mat2::Identity());
+  F.push_back(Mat2{{2.0, 1.0}, {4.0, 2.0}});                     // J = 0
+  F.push_back(Mat2{{0.0, 1.0}, {1.0, 0.0}});                     // J = -1
+  F.push_back(Mat2{{1e-200, 0.0}, {0.0, 1e-200}});               // J below the normal range
+  F.push_back(Mat2{{std::nan(""), 0.0}, {0.0, 1.0}});            // not finite
+  F.push_back(Mat2{{1e300, 0.0}, {0.0, 1e300}});                 // J = inf
+  const std::size_t n = F.size(), special = 5;
+  for (const NeoHookean& m : {kNeoHookean, NeoHookean{576923.0769230769, 384615.3846153846}}) {
+    std::vector<Mat2> lanes(n);
+    m.cauchy_stress_array(n, F.data(), lanes.data());
+    double worst = 0.0;
+    for (std::size_t p = 0; p < n; ++p) {
+      const Mat2 scalar = m.cauchy_stress(F[p]);
+      if (p + special >= n) {
+        for (int c = 0; c < 4; ++c)
+          EXPECT_EQ(bits(lanes[p](c)), bits(scalar(c))) << "F = " << show(F[p]) << ", entry " << c;
+        continue;
+      }
+      // The scale of each entry's terms: |p| + |mu / J| |B - I|.
+      const double J = mpmvv::determinant(F[p]);
+      const Mat2 B = F[p] * F[p].transpose();
+      const double scale = std::abs(m.lambda * std::log(J) / J) + std::abs(m.mu / J) * (B.cwiseAbs().maxCoeff() + 1.0);
+      for (int c = 0; c < 4; ++c) worst = std::max(worst, std::abs(lanes[p](c) - scalar(c)) / scale);
+    }
+    RecordProperty("largest_stress_difference_in_epsilon_of_scale", std::to_string(worst / std::numeric_limits<double>::epsilon()));
+    EXPECT_LE(worst, 4 * std::numeric_limits<double>::epsilon());
+    for (mpmvv::LaneBuild build : mpmvv::testing::lane_builds_of_this_cpu()) {
+      SCOPED_TRACE(mpmvv::name(build));
+      for (std::size_t count : {n, std::size_t(1), std::size_t(7), std::size_t(13)}) {
+        std::vector<Mat2> out(count);
+        mpmvv::neo_hookean_lane_stress(build, {m.lambda, m.mu}, count, mpmvv::values_of(F.data()),
+                                       mpmvv::values_of(out.data()));
+        for (std::size_t p = 0; p < std::min(count, n - special); ++p)
+          for (int c = 0; c < 4; ++c) ASSERT_EQ(bits(out[p](c)), bits(lanes[p](c))) << "count " << count;
+      }
+    }
   }
 }
 

@@ -6,8 +6,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <limits>
 
 #include "../tensor.hpp"
+#include "neo_hookean_lanes.hpp"
 #include "stress.hpp"
 
 namespace mpmvv {
@@ -33,6 +36,19 @@ struct NeoHookean {
   template <class T>
   Eigen::Matrix<T, 2, 2> cauchy_stress(const Eigen::Matrix<T, 2, 2>& F) const {
     return stress(F, T(1.0)).in_plane;
+  }
+
+  // cauchy_stress of n particles at once, in lanes (neo_hookean_lanes.hpp):
+  // the same operations with the lanes' ln J, within a unit in the last
+  // place of libm's. A J that is not positive, finite and normal (the state
+  // the scan then stops on) takes the scalar stress above.
+  void cauchy_stress_array(std::size_t n, const Mat2* F, Mat2* sigma) const {
+    if (neo_hookean_lane_stress({lambda, mu}, n, values_of(F), values_of(sigma)) == 0) return;
+    for (std::size_t p = 0; p < n; ++p) {
+      const double J = determinant(F[p]);
+      if (!(J >= std::numeric_limits<double>::min() && J <= std::numeric_limits<double>::max()))
+        sigma[p] = cauchy_stress(F[p]);
+    }
   }
 
   // Stored energy per reference volume, psi = mu/2 (I1 - 3) - mu ln J +

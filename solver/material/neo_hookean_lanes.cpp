@@ -4,6 +4,7 @@
 // in plane strain (F_33 = 1); std::max(a, b) is a < b ? b : a.
 #include "neo_hookean_lanes.hpp"
 
+#include "../lane_log.hpp"
 #include "../lane_vectors.hpp"
 
 namespace mpmvv {
@@ -65,12 +66,69 @@ void NeoHookeanScanKernel::body(const Grid& g, const In& in, Out& out, int l0) {
   store(out.may_set_speed + l0, __builtin_convertvector(~ruled_out, Ints));
 }
 
+// NeoHookean::stress with F_33 = 1, line by line:
+//   J = (F00 F11 - F01 F10) 1, p = lambda ln J / J, shear = mu / J,
+//   B = F F^T, sigma = p I + shear (B - I) entry by entry.
+struct NeoHookeanStressKernel {
+  using Grid = NeoHookeanStressLaneParams;
+  struct In {
+    const double* deformation_gradient;
+  };
+  struct Out {
+    double* stress;
+    double outside[kLanes];  // per lane, how many J were not positive, finite and normal
+  };
+
+  template <int W>
+  MPMVV_LANE_INLINE static void body(const Grid& g, const In& in, Out& out, int l0) {
+    using Lanes = typename Width<W>::Lanes;
+    using Mask = typename Width<W>::Mask;
+    Lanes F[4];
+    load_interleaved(in.deformation_gradient + 4 * l0, F);
+    const Lanes f00 = F[0], f10 = F[1], f01 = F[2], f11 = F[3];
+    const Lanes J = (f00 * f11 - f01 * f10) * 1.0;
+    const Mask normal = (J >= 0x1p-1022) & (J <= 0x1.fffffffffffffp+1023);
+    store(out.outside + l0, load<Lanes>(out.outside + l0) + (normal ? Lanes{} : Lanes{} + 1.0));
+    const Lanes p = g.lambda * lane_log(J) / J;
+    const Lanes shear = g.mu / J;
+    const Lanes b00 = f00 * f00 + f01 * f01, b01 = f00 * f10 + f01 * f11, b11 = f10 * f10 + f11 * f11;
+    const Lanes off = p * 0.0 + shear * (b01 - 0.0);
+    const Lanes sigma[4] = {p * 1.0 + shear * (b00 - 1.0), off, off, p * 1.0 + shear * (b11 - 1.0)};
+    store_interleaved(out.stress + 4 * l0, sigma);
+  }
+};
+
 }  // namespace
 
 namespace lanes::MPMVV_LANE_BUILD_NS {
 void neo_hookean_scan_lanes(const NeoHookeanScanLaneParams& params, const NeoHookeanScanLaneInput& in,
                             NeoHookeanScanLaneVerdict& out) {
   run<NeoHookeanScanKernel>(params, in, out);
+}
+
+void neo_hookean_stress_array(const NeoHookeanStressLaneParams& params, std::size_t n,
+                              const double* deformation_gradient, double* stress, std::size_t& outside) {
+  NeoHookeanStressKernel::Out out{stress, {}};
+  std::size_t k = 0;
+  for (; k + kLanes <= n; k += kLanes) {
+    out.stress = stress + 4 * k;
+    run<NeoHookeanStressKernel>(params, {deformation_gradient + 4 * k}, out);
+  }
+  auto count = [&] {
+    double sum = 0.0;
+    for (double c : out.outside) sum += c;
+    outside = std::size_t(sum);
+  };
+  if (k == n) return count();
+  // The last few through whole lanes: the spare ones hold F = I.
+  double F[4 * kLanes], sigma[4 * kLanes];
+  for (std::size_t l = 0; l < std::size_t(kLanes); ++l)
+    for (std::size_t c = 0; c < 4; ++c)
+      F[4 * l + c] = k + l < n ? deformation_gradient[4 * (k + l) + c] : (c == 0 || c == 3 ? 1.0 : 0.0);
+  out.stress = sigma;
+  run<NeoHookeanStressKernel>(params, {F}, out);
+  for (std::size_t v = 0; v < 4 * (n - k); ++v) stress[4 * k + v] = sigma[v];
+  count();
 }
 }  // namespace lanes::MPMVV_LANE_BUILD_NS
 
@@ -83,6 +141,18 @@ void neo_hookean_scan_lanes(LaneBuild build, const NeoHookeanScanLaneParams& par
 void neo_hookean_scan_lanes(const NeoHookeanScanLaneParams& params, const NeoHookeanScanLaneInput& in,
                             NeoHookeanScanLaneVerdict& out) {
   neo_hookean_scan_lanes(lane_build(), params, in, out);
+}
+
+std::size_t neo_hookean_lane_stress(LaneBuild build, const NeoHookeanStressLaneParams& params, std::size_t n,
+                                    const double* deformation_gradient, double* stress) {
+  std::size_t outside = 0;
+  MPMVV_LANE_BUILD_CALL(build, neo_hookean_stress_array(params, n, deformation_gradient, stress, outside));
+  return outside;
+}
+
+std::size_t neo_hookean_lane_stress(const NeoHookeanStressLaneParams& params, std::size_t n,
+                                    const double* deformation_gradient, double* stress) {
+  return neo_hookean_lane_stress(lane_build(), params, n, deformation_gradient, stress);
 }
 #endif
 

@@ -14,6 +14,8 @@
 // scan went from 67-70 to 58-63 ns.
 #pragma once
 
+#include <cstddef>
+
 #include "../lanes.hpp"
 
 namespace mpmvv {
@@ -69,18 +71,45 @@ void neo_hookean_scan_lanes(const NeoHookeanScanLaneParams& params, const NeoHoo
 void neo_hookean_scan_lanes(LaneBuild build, const NeoHookeanScanLaneParams& params,
                             const NeoHookeanScanLaneInput& in, NeoHookeanScanLaneVerdict& out);
 
+// The stress update of n particles in plane strain, NeoHookean::cauchy_stress
+// in lanes: F_p in, sigma_p out, four values a particle column by column as
+// Particles holds them. Each lane repeats cauchy_stress's operations in its
+// order, with ln J from the lanes (lane_log.hpp, within one unit in the last
+// place), so a stress differs from the scalar one by that unit at most.
+// Returns how many particles have a J = det F_p that is not positive, finite
+// and normal: their stresses are left for the caller to form
+// (neo_hookean.hpp: cauchy_stress_array).
+//
+// Why: libm's log was 48 of the 111 instructions a particle-step of the
+// scalar stress update on the ring (callgrind, 256 cells, CPDI and linear
+// MPM alike), its latency on every particle's path.
+struct NeoHookeanStressLaneParams {
+  double lambda, mu;
+};
+
+std::size_t neo_hookean_lane_stress(const NeoHookeanStressLaneParams& params, std::size_t n,
+                                    const double* deformation_gradient, double* stress);
+std::size_t neo_hookean_lane_stress(LaneBuild build, const NeoHookeanStressLaneParams& params, std::size_t n,
+                                    const double* deformation_gradient, double* stress);
+
 // Each build's own, compiled for its instructions (solver/CMakeLists.txt).
 namespace lanes::avx512 {
 void neo_hookean_scan_lanes(const NeoHookeanScanLaneParams& params, const NeoHookeanScanLaneInput& in,
                             NeoHookeanScanLaneVerdict& out);
+void neo_hookean_stress_array(const NeoHookeanStressLaneParams& params, std::size_t n,
+                              const double* deformation_gradient, double* stress, std::size_t& outside);
 }
 namespace lanes::avx2 {
 void neo_hookean_scan_lanes(const NeoHookeanScanLaneParams& params, const NeoHookeanScanLaneInput& in,
                             NeoHookeanScanLaneVerdict& out);
+void neo_hookean_stress_array(const NeoHookeanStressLaneParams& params, std::size_t n,
+                              const double* deformation_gradient, double* stress, std::size_t& outside);
 }
 namespace lanes::baseline {
 void neo_hookean_scan_lanes(const NeoHookeanScanLaneParams& params, const NeoHookeanScanLaneInput& in,
                             NeoHookeanScanLaneVerdict& out);
+void neo_hookean_stress_array(const NeoHookeanStressLaneParams& params, std::size_t n,
+                              const double* deformation_gradient, double* stress, std::size_t& outside);
 }
 
 }  // namespace mpmvv

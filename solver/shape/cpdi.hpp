@@ -291,13 +291,13 @@ struct CpdiShapeT {
   // Eight particles' stencils in two steps: compute_lanes runs the kernel on
   // particles first, ..., first + count - 1 (count at most kLanes), then
   // for_each_lane_entry gives lane l's entries as evaluate lists them, and
-  // lane_gradient_bound an upper bound of their sum_g |G_gp| (the time-step
+  // lane_gradient_bounds upper bounds of their sum_g |G_gp| (the time-step
   // scan's, negative where there is none; stages.hpp: signal_speed, and
   // list_lane for the entries as a stencil). In between, lane_inside is
   // `inside` of the lane's particle from the kernel's values, for the scan's
   // health test: a particle that fails it is not listed (its domain may
   // leave the grid). `for_scan` asks the kernel for what lane_inside and
-  // lane_gradient_bound need (the time-step scan), `build` for a build of
+  // lane_gradient_bounds need (the time-step scan), `build` for a build of
   // the kernel (tests; by default the widest the CPU has).
   struct LaneBatch {
     std::size_t first;
@@ -315,7 +315,7 @@ struct CpdiShapeT {
       in = {values_of(position + first), values_of(deformation_gradient + first), values_of(half_size + first)};
     } else {
       for (int l = 0; l < kLanes; ++l) {
-        const std::size_t p = first + std::size_t(l < count ? l : 0);  // spare lanes repeat the first
+        const std::size_t p = copied_lane_particle(first, count, l);
         std::copy_n(values_of(position + p), 2, copy.position + 2 * l);
         const Mat2 s = domain(p);
         std::copy_n(values_of(&s), 4, copy.deformation_gradient + 4 * l);
@@ -367,13 +367,8 @@ struct CpdiShapeT {
       }
   }
 
-  // The bound of sum_g |G_gp| the kernel gives with lane l's entries, and
-  // the eight lanes' bounds back to back (the spare lanes' the first's).
-  double lane_gradient_bound(const LaneBatch& batch, int l) const
-    requires lanes
-  {
-    return batch.out.gradient_bound[l];
-  }
+  // The bounds of sum_g |G_gp| the kernel gives with the lanes' entries, the
+  // eight lanes' back to back (the spare lanes' the first's).
   const double* lane_gradient_bounds(const LaneBatch& batch) const
     requires lanes
   {

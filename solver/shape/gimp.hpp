@@ -152,7 +152,7 @@ struct GimpShapeT {
     GimpLaneCopy copy;
     if (count < kLanes) {
       for (int l = 0; l < kLanes; ++l) {
-        const std::size_t p = first + std::size_t(l < count ? l : 0);  // spare lanes repeat the first
+        const std::size_t p = copied_lane_particle(first, count, l);
         std::copy_n(values_of(position + p), 2, copy.position + 2 * l);
         std::copy_n(values_of(half_size + p), 2, copy.half_size + 2 * l);
       }
@@ -189,11 +189,7 @@ struct GimpShapeT {
       }
   }
 
-  double lane_gradient_bound(const LaneBatch&, int) const
-    requires lanes
-  {
-    return -1.0;
-  }
+  // No bounds of sum_g |G_gp|: uGIMP's gradients are the grid basis's.
   const double* lane_gradient_bounds(const LaneBatch&) const
     requires lanes
   {
