@@ -90,8 +90,11 @@ void list_lane(const Shape& shape, const typename Shape::LaneBatch& batch, int l
 // scan, where its bounds do not settle a speed). usable(p, inside) is asked
 // first, with the shape's test of the particle's domain in the grid (from
 // the lanes' own values where `for_scan`, as are the bounds); a particle it
-// refuses is skipped. With lanes, `on_lanes(first, count, batch)` sees each
-// batch before its particles are visited. Ends with the threads' barrier.
+// refuses is skipped. `on_lanes(first, count, gradient_bounds)`, where
+// given, sees each batch of kLanes particles before they are visited, with
+// the kernel's bounds of the batch (lane_gradient_bounds; null without lanes
+// or bounds): the particles go in batches then for any shape. Ends with the
+// threads' barrier.
 struct NoLaneHook {};
 
 template <class Shape, class Usable, class Visit, class OnLanes = NoLaneHook>
@@ -105,7 +108,8 @@ void for_each_stencil(const Shape& shape, std::size_t begin, std::size_t end, bo
     for (std::size_t p0 = first; p0 < last; p0 += kLanes) {
       const int count = int(std::min<std::size_t>(kLanes, last - p0));
       shape.compute_lanes(p0, count, batch, for_scan);
-      if constexpr (!std::is_same_v<OnLanes, NoLaneHook>) on_lanes(p0, count, batch);
+      const double* bounds = shape.lane_gradient_bounds(batch);
+      if constexpr (!std::is_same_v<OnLanes, NoLaneHook>) on_lanes(p0, count, bounds);
       for (int l = 0; l < count; ++l) {
         const std::size_t p = p0 + std::size_t(l);
         if (!usable(p, [&] { return shape.lane_inside(batch, l); })) continue;
@@ -115,17 +119,28 @@ void for_each_stencil(const Shape& shape, std::size_t begin, std::size_t end, bo
           listed = true;
           return s;
         };
-        const double* bounds = shape.lane_gradient_bounds(batch);
         visit(p, [&](auto&& f) { shape.for_each_lane_entry(batch, l, f); }, stencil_of, bounds ? bounds[l] : -1.0);
       }
     }
 #pragma omp barrier
   } else {
-#pragma omp for schedule(static)
-    for (std::size_t p = begin; p < end; ++p) {
-      if (!usable(p, [&] { return shape.inside(p); })) continue;
+    auto one = [&](std::size_t p) {
+      if (!usable(p, [&] { return shape.inside(p); })) return;
       shape.evaluate(p, s);
       visit(p, entries_of(s), stencil_s, -1.0);
+    };
+    if constexpr (!std::is_same_v<OnLanes, NoLaneHook>) {
+      // The static schedule's block, kLanes at a time (parallel.hpp: static_block).
+      const auto [first, last] = static_block(begin, end);
+      for (std::size_t p0 = first; p0 < last; p0 += kLanes) {
+        const std::size_t stop = std::min<std::size_t>(p0 + kLanes, last);
+        on_lanes(p0, int(stop - p0), nullptr);
+        for (std::size_t p = p0; p < stop; ++p) one(p);
+      }
+#pragma omp barrier
+    } else {
+#pragma omp for schedule(static)
+      for (std::size_t p = begin; p < end; ++p) one(p);
     }
   }
 }
@@ -224,8 +239,8 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
       return true;
     };
     for_each_stencil(shape, range.first, n, scanning, usable, map,
-                     [&](std::size_t first, int count, const auto& batch) {
-                       if constexpr (scanning) scan->screen_lanes(first, count, batch, max_speed, screen);
+                     [&](std::size_t first, int count, const double* gradient_bounds) {
+                       if constexpr (scanning) scan->screen_lanes(first, count, gradient_bounds, max_speed, screen);
                      });
     if constexpr (scanning) {
       // A largest and a lowest: the same whatever order the threads come in.
@@ -878,20 +893,24 @@ struct ScanInMap {
   ParticleScan result{0.0, P.size()};
 
   // Where the material has a lane kernel of the scan's first tests
-  // (neo_hookean_lanes.hpp) and the shape evaluates by lanes, the batch's
-  // particles are screened together into `screen`: the scan then asks each
-  // only of what the screen left open. Otherwise the screen stays empty.
-  static constexpr bool screens = std::is_same_v<Material, NeoHookean> && evaluates_lanes<Shape>() &&
+  // (neo_hookean_lanes.hpp), in plane strain, the batch's particles are
+  // screened together into `screen`: the scan then asks each only of what
+  // the screen left open. A shape whose gradients reach beyond the grid
+  // basis needs the lane kernel's bounds of its stencils for that, so it is
+  // screened only where it evaluates by lanes. Otherwise the screen stays
+  // empty.
+  static constexpr bool screens = std::is_same_v<Material, NeoHookean> &&
+                                  (evaluates_lanes<Shape>() || !Shape::gradients_beyond_grid_basis) &&
                                   Shape::geometry == Geometry::plane_strain &&
                                   !requires(const Shape& s) { s.cell_stretch(std::size_t(0)); };
 
-  template <class Batch>
-  void screen_lanes(std::size_t first, int count, const Batch& batch, double largest, ScanScreen& screen) const {
+  void screen_lanes(std::size_t first, int count, const double* gradient_bounds, double largest,
+                    ScanScreen& screen) const {
     if constexpr (screens) {
       const NeoHookeanScanLaneParams params{material.lambda, material.mu, material.p_wave_modulus(), largest, h,
                                             1.0 / kGridBasisGradientBound, Shape::gradients_beyond_grid_basis};
       NeoHookeanScanLaneCopy copy;
-      const NeoHookeanScanLaneInput in = scan_lane_input(P, first, count, shape.lane_gradient_bounds(batch), copy);
+      const NeoHookeanScanLaneInput in = scan_lane_input(P, first, count, gradient_bounds, copy);
       neo_hookean_scan_lanes(params, in, screen.verdict);
       screen.first = first;
       screen.valid = true;
