@@ -48,8 +48,9 @@ namespace mpmvv::lanes::MPMVV_LANE_BUILD_NS {
 
 inline constexpr int kWidth = MPMVV_LANE_WIDTH;
 
-// W lanes of doubles, of their comparisons, of ints and of the doubles' bits (one specialization
-// per width: GCC keeps a vector size only where it is not a template's).
+// W lanes of doubles, of their comparisons, of ints and of the doubles' bits
+// (one specialization per width: GCC keeps a vector size only where it is not
+// a template's).
 template <int W>
 struct Width;
 template <>

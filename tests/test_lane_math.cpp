@@ -186,7 +186,8 @@ TEST(LaneLog, EveryBuildAndCountGivesTheSameBits) {
 // Zero, negative, subnormal, infinite and NaN arguments take libm's values.
 TEST(LaneLog, OutsideTheNormalRangeTheValuesAreLibms) {
   const double inf = std::numeric_limits<double>::infinity();
-  const std::vector<double> x = {0.0, -0.0, -1.0, 5e-324, std::numeric_limits<double>::denorm_min() * 77, inf, -inf, 3.0};
+  const std::vector<double> x = {0.0, -0.0, -1.0, 5e-324, std::numeric_limits<double>::denorm_min() * 77,
+                                 inf, -inf, 3.0};
   for (LaneBuild build : mpmvv::testing::lane_builds_of_this_cpu()) {
     SCOPED_TRACE(mpmvv::name(build));
     std::vector<double> l(x.size());

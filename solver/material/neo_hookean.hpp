@@ -40,8 +40,8 @@ struct NeoHookean {
 
   // cauchy_stress of n particles at once, in lanes (neo_hookean_lanes.hpp):
   // the same operations with the lanes' ln J, within a unit in the last
-  // place of libm's. A J that is not positive, finite and normal (the state
-  // the scan then stops on) takes the scalar stress above.
+  // place. A J that is not positive, finite and normal (the state the scan
+  // then stops on) takes the scalar stress above.
   void cauchy_stress_array(std::size_t n, const Mat2* F, Mat2* sigma) const {
     if (neo_hookean_lane_stress({lambda, mu}, n, values_of(F), values_of(sigma)) == 0) return;
     for (std::size_t p = 0; p < n; ++p) {

@@ -75,7 +75,8 @@ void neo_hookean_scan_lanes(LaneBuild build, const NeoHookeanScanLaneParams& par
 // in lanes: F_p in, sigma_p out, four values a particle column by column as
 // Particles holds them. Each lane repeats cauchy_stress's operations in its
 // order, with ln J from the lanes (lane_log.hpp, within one unit in the last
-// place), so a stress differs from the scalar one by that unit at most.
+// place), so a stress differs from the scalar one only through ln J's last
+// place (tests/test_materials.cpp: within 1.6 epsilon of its terms' size).
 // Returns how many particles have a J = det F_p that is not positive, finite
 // and normal: their stresses are left for the caller to form
 // (neo_hookean.hpp: cauchy_stress_array).
