@@ -4,6 +4,7 @@
 // one virtual call per step, the loop inside).
 #pragma once
 
+#include <limits>
 #include <memory>
 #include <string>
 #include <variant>
@@ -21,6 +22,14 @@ class ExactSolution {
   virtual double density() const = 0;
   virtual Vec2 position(const Vec2& X, double t) const = 0;
   virtual ExactFields fields(const Vec2& X, double t) const = 0;
+  // The same without the acceleration and the body force (NaN there), and
+  // where a solution can, for less work (Manufactured::state): what the
+  // seeding, and the errors and monitors at output times, read.
+  virtual ExactFields state(const Vec2& X, double t) const {
+    ExactFields f = fields(X, t);
+    f.acceleration = f.body_force = Vec2::Constant(std::numeric_limits<double>::quiet_NaN());
+    return f;
+  }
   virtual Vec2 body_force(const Vec2& X, double t) const = 0;
   // b at every reference position (threads over the array).
   virtual void body_forces(double t, const std::vector<Vec2>& X, std::vector<Vec2>& b) const = 0;
@@ -39,6 +48,7 @@ class ManufacturedSolution final : public ExactSolution {
   double density() const override { return m_.density(); }
   Vec2 position(const Vec2& X, double t) const override { return m_.position(X, t); }
   ExactFields fields(const Vec2& X, double t) const override { return m_.fields(X, t); }
+  ExactFields state(const Vec2& X, double t) const override { return m_.state(X, t); }
   Vec2 body_force(const Vec2& X, double t) const override { return m_.body_force(X, t); }
   void body_forces(double t, const std::vector<Vec2>& X, std::vector<Vec2>& b) const override {
     const std::size_t n = X.size();

@@ -22,6 +22,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "jet.hpp"
@@ -145,6 +146,45 @@ class Manufactured {
     return temporal(X, t).acceleration - divergence(spatial(X, t), X) / density_;
   }
 
+  // The fields without the acceleration and the body force (NaN there),
+  // for a fraction of fields' work: one evaluation of the motion in a jet
+  // of X, Y and t gives position, F and velocity, where fields evaluates it
+  // twice with second derivatives (d2x/dt2; dF/dX for Div P); the stresses
+  // come from F in value-only jets (Jet0), which divide as fields' jets do
+  // (by a product with the inverse). Each partial derivative of a jet is
+  // formed from the values and itself alone, and the value part of a nested
+  // jet is the inner jet's own evaluation, so every value is fields' to the
+  // bit (test_manufactured.cpp: StateIsFieldsWithoutTheBodyForce).
+  ExactFields state(const Vec2& X, double t) const {
+    using Jet3 = Jet<double, 3>;  // X, Y, t
+    const Eigen::Matrix<Jet3, 2, 1> XJ(Jet3::variable(X.x(), 0), Jet3::variable(X.y(), 1));
+    const Eigen::Matrix<Jet3, 2, 1> x = motion_.position(XJ, Jet3::variable(t, 2));
+    ExactFields f;
+    f.position = Vec2(x[0].v, x[1].v);
+    f.displacement = f.position - X;
+    f.velocity = Vec2(x[0].d[2], x[1].d[2]);
+    f.acceleration = Vec2::Constant(std::numeric_limits<double>::quiet_NaN());
+    Mat0 F;
+    for (int i = 0; i < 2; ++i)
+      for (int K = 0; K < 2; ++K) F(i, K) = Jet0(x[i].d[K]);
+    const Jet0 F33 = geometry_ == Geometry::axisymmetric ? Jet0(x[0].v) / Jet0(X.x()) : Jet0(1.0);
+    const Stress<Jet0> sigma = material_.stress(F, F33);
+    const Jet0 det2 = F(0, 0) * F(1, 1) - F(0, 1) * F(1, 0);
+    const Jet0 J = det2 * F33;
+    Mat0 F_inv_t;
+    F_inv_t << F(1, 1) / det2, -F(1, 0) / det2, -F(0, 1) / det2, F(0, 0) / det2;
+    const Mat0 P = J * sigma.in_plane * F_inv_t;
+    f.deformation_gradient = value(F);
+    f.hoop_stretch = F33.v;
+    f.J = determinant(f.deformation_gradient) * f.hoop_stretch;
+    f.cauchy_stress = value(sigma.in_plane);
+    f.cauchy_stress_33 = sigma.out_of_plane.v;
+    f.first_piola = value(P);
+    f.first_piola_33 = (J * sigma.out_of_plane / F33).v;
+    f.body_force = Vec2::Constant(std::numeric_limits<double>::quiet_NaN());
+    return f;
+  }
+
   // The residual of the balance of momentum at X, t by finite differences only
   // (sixth-order central differences with steps `step` = 1e-3 of the motion's
   // length and time scales: truncation mostly falls below the round-off of
@@ -193,6 +233,8 @@ class Manufactured {
   using SpaceJet = Jet<Jet2, 2>;  // X with gradient and Hessian
   using Vec2J = Eigen::Matrix<Jet2, 2, 1>;
   using Mat2J = Eigen::Matrix<Jet2, 2, 2>;
+  using Jet0 = Jet<double, 0>;  // a value with no derivative, in the jets' arithmetic
+  using Mat0 = Eigen::Matrix<Jet0, 2, 2>;
 
   struct Temporal {
     Vec2 position, velocity, acceleration;
@@ -206,7 +248,8 @@ class Manufactured {
     Jet2 P33;
   };
 
-  static Mat2 value(const Mat2J& m) {
+  template <class M>
+  static Mat2 value(const M& m) {
     Mat2 r;
     for (int i = 0; i < 2; ++i)
       for (int j = 0; j < 2; ++j) r(i, j) = m(i, j).v;

@@ -119,30 +119,46 @@ MPMVV_LANE_INLINE void load_interleaved(const double* a, V (&v)[S]) {
   }
 }
 
-// The inverse of deinterleave: a and b hold even[0], odd[0], even[1], ...
-template <class V>
-MPMVV_LANE_INLINE void interleave(const V& even, const V& odd, V& a, V& b) {
-  constexpr std::size_t W = sizeof(V) / sizeof(double);
-  using Index = typename Width<int(W)>::Mask;
-  // Value k of the 2W in turn is even[k / 2] or odd[k / 2] (index W + k / 2).
-  constexpr Index low = []<std::size_t... k>(std::index_sequence<k...>) {
-    return Index{(long long)(k % 2 ? W + k / 2 : k / 2)...};
-  }(std::make_index_sequence<W>{});
-  a = __builtin_shuffle(even, odd, low);
-  b = __builtin_shuffle(even, odd, low + (long long)(W / 2));
-}
-
 // The inverse of load_interleaved (S = 4): value c of every lane from v[c]
-// into an array that holds four values per lane, one lane after another.
+// into an array that holds four values per lane, one lane after another. A
+// 4 x W transpose by the shuffles each width does in one instruction (the
+// unpacks of pairs, then whole halves or quarters), each row stored as it
+// is formed.
 template <class V>
 MPMVV_LANE_INLINE void store_interleaved(double* a, const V (&v)[4]) {
   constexpr int W = int(sizeof(V) / sizeof(double));
-  V even[2], odd[2], out[4];
-  interleave(v[0], v[2], even[0], even[1]);
-  interleave(v[1], v[3], odd[0], odd[1]);
-  interleave(even[0], odd[0], out[0], out[1]);
-  interleave(even[1], odd[1], out[2], out[3]);
-  for (int k = 0; k < 4; ++k) store(a + k * W, out[k]);
+  using Index = typename Width<W>::Mask;
+  if constexpr (W == 2) {
+    store(a, __builtin_shuffle(v[0], v[1], Index{0, 2}));
+    store(a + 2, __builtin_shuffle(v[2], v[3], Index{0, 2}));
+    store(a + 4, __builtin_shuffle(v[0], v[1], Index{1, 3}));
+    store(a + 6, __builtin_shuffle(v[2], v[3], Index{1, 3}));
+  } else if constexpr (W == 4) {
+    // t0 = v0_0 v1_0 v0_2 v1_2, t1 = v0_1 v1_1 v0_3 v1_3, t2 and t3 the same of v2 and v3.
+    const V t0 = __builtin_shuffle(v[0], v[1], Index{0, 4, 2, 6});
+    const V t1 = __builtin_shuffle(v[0], v[1], Index{1, 5, 3, 7});
+    const V t2 = __builtin_shuffle(v[2], v[3], Index{0, 4, 2, 6});
+    const V t3 = __builtin_shuffle(v[2], v[3], Index{1, 5, 3, 7});
+    store(a, __builtin_shuffle(t0, t2, Index{0, 1, 4, 5}));
+    store(a + 4, __builtin_shuffle(t1, t3, Index{0, 1, 4, 5}));
+    store(a + 8, __builtin_shuffle(t0, t2, Index{2, 3, 6, 7}));
+    store(a + 12, __builtin_shuffle(t1, t3, Index{2, 3, 6, 7}));
+  } else {
+    static_assert(W == 8);
+    const V t0 = __builtin_shuffle(v[0], v[1], Index{0, 8, 2, 10, 4, 12, 6, 14});
+    const V t1 = __builtin_shuffle(v[0], v[1], Index{1, 9, 3, 11, 5, 13, 7, 15});
+    const V t2 = __builtin_shuffle(v[2], v[3], Index{0, 8, 2, 10, 4, 12, 6, 14});
+    const V t3 = __builtin_shuffle(v[2], v[3], Index{1, 9, 3, 11, 5, 13, 7, 15});
+    // Lanes 0 and 2, 1 and 3, 4 and 6, 5 and 7.
+    const V r02 = __builtin_shuffle(t0, t2, Index{0, 1, 8, 9, 2, 3, 10, 11});
+    const V r13 = __builtin_shuffle(t1, t3, Index{0, 1, 8, 9, 2, 3, 10, 11});
+    const V r46 = __builtin_shuffle(t0, t2, Index{4, 5, 12, 13, 6, 7, 14, 15});
+    const V r57 = __builtin_shuffle(t1, t3, Index{4, 5, 12, 13, 6, 7, 14, 15});
+    store(a, __builtin_shuffle(r02, r13, Index{0, 1, 2, 3, 8, 9, 10, 11}));
+    store(a + 8, __builtin_shuffle(r02, r13, Index{4, 5, 6, 7, 12, 13, 14, 15}));
+    store(a + 16, __builtin_shuffle(r46, r57, Index{0, 1, 2, 3, 8, 9, 10, 11}));
+    store(a + 24, __builtin_shuffle(r46, r57, Index{4, 5, 6, 7, 12, 13, 14, 15}));
+  }
 }
 
 template <class V>

@@ -577,7 +577,7 @@ class MmsCase final : public SceneCase, private RunObserver {
     particle_volume_ = 0.0;
     for (std::size_t p = 0; p < pieces.size(); ++p) {
       const Vec2 X = pieces[p].centroid;
-      const mms::ExactFields f = setup_.solution->fields(X, 0.0);
+      const mms::ExactFields f = setup_.solution->state(X, 0.0);
       const double reference_volume = axisymmetric ? pieces[p].moment_r : pieces[p].area;
       P.reference_position[p] = X;
       P.position[p] = f.position;
@@ -762,11 +762,19 @@ class MmsCase final : public SceneCase, private RunObserver {
     double exact_spin = std::numeric_limits<double>::quiet_NaN();
     if (setup_.exact_motion && setup_.geometry == Geometry::plane_strain) {
       const Particles& P = s.model().particles;
-      exact_spin = 0.0;
-      for (std::size_t p = 0; p < P.size(); ++p) {
-        const mms::ExactFields f = setup_.solution->fields(P.reference_position[p], t);
-        exact_spin += P.mass[p] * (f.position.x() * f.velocity.y() - f.position.y() * f.velocity.x());
+      const std::size_t n = P.size();
+      ThreadOrderedSums<1> sums;  // the same bits for a given thread count
+#pragma omp parallel
+      {
+        double spin = 0.0;
+#pragma omp for schedule(static)
+        for (std::size_t p = 0; p < n; ++p) {
+          const mms::ExactFields f = setup_.solution->state(P.reference_position[p], t);
+          spin += P.mass[p] * (f.position.x() * f.velocity.y() - f.position.y() * f.velocity.x());
+        }
+        sums.keep({spin});
       }
+      exact_spin = sums.total()[0];
     }
     monitor_rows_.push_back({t, m, w, created, frequency, cfl_step, exact_spin, largest_energy_, m.min_J, m.max_J,
                              Vec2::Constant(std::numeric_limits<double>::quiet_NaN())});
@@ -924,7 +932,7 @@ class MmsCase final : public SceneCase, private RunObserver {
         double pressure = 0.0, deformation = 0.0, velocity = 0.0;
 #pragma omp for schedule(static)
         for (std::size_t p = 0; p < n; ++p) {
-          const mms::ExactFields f = setup_.solution->fields(P.reference_position[p], t);
+          const mms::ExactFields f = setup_.solution->state(P.reference_position[p], t);
           j_ratio_[p] = determinant(P.deformation_gradient[p]) * (axisymmetric ? P.hoop_stretch[p] : 1.0) /
                         (determinant(f.deformation_gradient) * f.hoop_stretch);
           const double e = 0.5 * ((P.stress[p] - f.cauchy_stress).trace());

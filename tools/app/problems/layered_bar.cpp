@@ -66,6 +66,7 @@ class LayeredSolution final : public mms::ExactSolution {
   double density() const override { return first_->density(); }
   Vec2 position(const Vec2& X, double t) const override { return first_->position(X, t); }
   mms::ExactFields fields(const Vec2& X, double t) const override { return of(X).fields(X, t); }
+  mms::ExactFields state(const Vec2& X, double t) const override { return of(X).state(X, t); }
   Vec2 body_force(const Vec2& X, double t) const override { return of(X).body_force(X, t); }
   void body_forces(double t, const std::vector<Vec2>& X, std::vector<Vec2>& b) const override {
     for (std::size_t p = 0; p < X.size(); ++p) b[p] = body_force(X[p], t);
