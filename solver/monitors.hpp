@@ -93,10 +93,10 @@ Monitors monitor_particles(const Shape& shape, const Material& material, const P
       const double c = std::sqrt(material.wave_modulus(P.deformation_gradient[p], F33, P.stress[p]) / density);
       mach = std::max(mach, P.velocity[p].norm() / c);
       wave_ratio = std::max(wave_ratio, c / std::sqrt(material.p_wave_modulus() * P.reference_volume[p] / P.mass[p]));
-      double basis = 1.0;
-      if constexpr (requires { shape.cell_stretch(p); }) basis = 1.0 / std::min(1.0, shape.cell_stretch(p));
-      if constexpr (Shape::gradients_beyond_grid_basis) basis = std::max(basis, stiffening(shape, p, grid.h));
-      basis_stiffening = std::max(basis_stiffening, basis);
+      if constexpr (requires { shape.cell_stretch(p); })
+        basis_stiffening = std::max(basis_stiffening, 1.0 / std::min(1.0, shape.cell_stretch(p)));
+      else
+        basis_stiffening = std::max(basis_stiffening, 1.0);
       const Mat2 s = shape.domain(p);
       if constexpr (has_domain) {
         const double area = std::abs(determinant(s));
@@ -114,6 +114,23 @@ Monitors monitor_particles(const Shape& shape, const Material& material, const P
         if (shape.folded(p)) ++folded;
     }
     sums.keep({kinetic, strain, spin});
+    if constexpr (Shape::gradients_beyond_grid_basis) {
+      // k_p from each particle's stencil, the lanes' eight at a time where the
+      // shape has them. A particle whose kernel bound of sum_g |G_gp| (above
+      // the sum itself), lifted past its rounding as signal_speed lifts it,
+      // keeps k_p below the largest so far cannot raise it, and is not
+      // listed: the largest is the number forming every k_p gives.
+      double largest = 1.0;
+      for_each_stencil(
+          shape, begin, n, true, [](std::size_t, auto) { return true; },
+          [&](std::size_t, auto&&, auto&& stencil_of, double gradient_bound) {
+            if (gradient_bound >= 0.0 && grid.h * gradient_bound / kGridBasisGradientBound * (1.0 + 1e-12) < largest)
+              return;
+            largest = std::max(largest, stiffening(stencil_of(), grid.h));
+          });
+#pragma omp critical
+      basis_stiffening = std::max(basis_stiffening, largest);
+    }
   }
   const auto [kinetic, strain, spin] = sums.total();
   m.kinetic = kinetic;

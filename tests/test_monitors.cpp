@@ -179,6 +179,44 @@ TEST(Monitors, WhatLiftsTheStepIsNamed) {
               2.0, 1e-12);
 }
 
+// The largest k_p over many particles is the largest of stiffening(shape, p)
+// to the bit, on one thread and two, where the monitor reads the lanes'
+// bounds to list only particles that could raise it: random strains and
+// shears (merged and wide CPDI stencils), the largest in the last, partial
+// batch of eight or anywhere.
+TEST(Monitors, BasisStiffeningIsTheLargestOfEveryParticle) {
+  const mpmvv::GridGeometry grid = mpmvv::GridGeometry::walled(mpmvv::Vec2(-2.0, -2.0), 0.25, 24, 24);
+  const mpmvv::NeoHookean material{577.0, 385.0};
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<double> where(-1.0, 1.0), strain(-0.3, 0.3), shear(-2.0, 2.0);
+  const std::size_t n = 301;
+  mpmvv::Particles P;
+  P.resize(n);
+  P.half_size.assign(n, mpmvv::Vec2(0.25 * grid.h, 0.25 * grid.h));
+  for (std::size_t p = 0; p < n; ++p) {
+    P.position[p] = P.reference_position[p] = mpmvv::Vec2(where(rng), where(rng));
+    P.deformation_gradient[p] << 1.0 + strain(rng), strain(rng), strain(rng), 1.0 + strain(rng);
+    if (p % 3 == 0) P.deformation_gradient[p](0, 1) = shear(rng);
+    P.mass[p] = 1.0;
+    P.reference_volume[p] = 0.01;
+    P.volume[p] = 0.01 * mpmvv::determinant(P.deformation_gradient[p]);
+  }
+  const int threads_before = mpmvv::max_threads();
+  for (bool last_is_largest : {false, true}) {
+    if (last_is_largest) P.deformation_gradient[n - 1] << 1.0, 3.5, 0.0, 1.0;
+    const mpmvv::CpdiShape shape = mpmvv::CpdiShape::bind(grid, P);
+    double largest = 1.0;
+    for (std::size_t p = 0; p < n; ++p) largest = std::max(largest, mpmvv::stiffening(shape, p, grid.h));
+    EXPECT_GT(largest, 1.2);
+    for (int threads : {1, 2}) {
+      mpmvv::set_threads(threads);
+      EXPECT_EQ(mpmvv::monitor_particles(shape, material, P, grid).max_basis_stiffening, largest)
+          << threads << " threads" << (last_is_largest ? ", the largest last" : "");
+    }
+  }
+  mpmvv::set_threads(threads_before);
+}
+
 // The cell-averaged dilatation (eqs. 1.82-1.84) gives every particle of a cell
 // the cell's J = sum V / sum V0, keeps each cell's volume, and leaves the
 // isochoric part of F alone.
