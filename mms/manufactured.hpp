@@ -169,18 +169,16 @@ class Manufactured {
       for (int K = 0; K < 2; ++K) F(i, K) = Jet0(x[i].d[K]);
     const Jet0 F33 = geometry_ == Geometry::axisymmetric ? Jet0(x[0].v) / Jet0(X.x()) : Jet0(1.0);
     const Stress<Jet0> sigma = material_.stress(F, F33);
-    const Jet0 det2 = F(0, 0) * F(1, 1) - F(0, 1) * F(1, 0);
-    const Jet0 J = det2 * F33;
-    Mat0 F_inv_t;
-    F_inv_t << F(1, 1) / det2, -F(1, 0) / det2, -F(0, 1) / det2, F(0, 0) / det2;
-    const Mat0 P = J * sigma.in_plane * F_inv_t;
+    Mat0 P;
+    Jet0 P33;
+    first_piola(F, F33, sigma, P, P33);
     f.deformation_gradient = value(F);
     f.hoop_stretch = F33.v;
     f.J = determinant(f.deformation_gradient) * f.hoop_stretch;
     f.cauchy_stress = value(sigma.in_plane);
     f.cauchy_stress_33 = sigma.out_of_plane.v;
     f.first_piola = value(P);
-    f.first_piola_33 = (J * sigma.out_of_plane / F33).v;
+    f.first_piola_33 = P33.v;
     f.body_force = Vec2::Constant(std::numeric_limits<double>::quiet_NaN());
     return f;
   }
@@ -292,13 +290,21 @@ class Manufactured {
       s.F33 = Jet2(1.0);
     }
     s.sigma = material_.stress(s.F, s.F33);
-    const Jet2 J = (s.F(0, 0) * s.F(1, 1) - s.F(0, 1) * s.F(1, 0)) * s.F33;
-    const Jet2 det2 = s.F(0, 0) * s.F(1, 1) - s.F(0, 1) * s.F(1, 0);
-    Mat2J F_inv_t;
-    F_inv_t << s.F(1, 1) / det2, -s.F(1, 0) / det2, -s.F(0, 1) / det2, s.F(0, 0) / det2;
-    s.P = J * s.sigma.in_plane * F_inv_t;
-    s.P33 = J * s.sigma.out_of_plane / s.F33;
+    first_piola(s.F, s.F33, s.sigma, s.P, s.P33);
     return s;
+  }
+
+  // P = J sigma F^-T and P_33 = J sigma_33 / F_33, J = det F F_33, in the
+  // arithmetic of either jet (spatial; state's value-only jets).
+  template <class T>
+  static void first_piola(const Eigen::Matrix<T, 2, 2>& F, const T& F33, const Stress<T>& sigma,
+                          Eigen::Matrix<T, 2, 2>& P, T& P33) {
+    const T det2 = F(0, 0) * F(1, 1) - F(0, 1) * F(1, 0);
+    const T J = det2 * F33;
+    Eigen::Matrix<T, 2, 2> F_inv_t;
+    F_inv_t << F(1, 1) / det2, -F(1, 0) / det2, -F(0, 1) / det2, F(0, 0) / det2;
+    P = J * sigma.in_plane * F_inv_t;
+    P33 = J * sigma.out_of_plane / F33;
   }
 
   Vec2 divergence(const Spatial& s, const Vec2& X) const {
