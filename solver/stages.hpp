@@ -79,6 +79,17 @@ void list_lane(const Shape& shape, const typename Shape::LaneBatch& batch, int l
   st.count = n;
 }
 
+// The batch a shape's lane kernel fills (an empty one for a shape without).
+template <class Shape>
+struct LaneBatchOf {
+  struct type {};
+};
+template <class Shape>
+  requires(evaluates_lanes<Shape>())
+struct LaneBatchOf<Shape> {
+  using type = typename Shape::LaneBatch;
+};
+
 // Called by every thread of a parallel region: each particle of [begin, end)
 // the static schedule gives the thread, in order, with its stencil, as
 //   visit(p, entries, stencil_of, gradient_bound)
@@ -100,48 +111,47 @@ struct NoLaneHook {};
 template <class Shape, class Usable, class Visit, class OnLanes = NoLaneHook>
 void for_each_stencil(const Shape& shape, std::size_t begin, std::size_t end, bool for_scan, Usable usable,
                       Visit visit, OnLanes on_lanes = {}) {
+  constexpr bool lanes = evaluates_lanes<Shape>();
+  constexpr bool hooked = !std::is_same_v<OnLanes, NoLaneHook>;
   Stencil<Shape::stencil_size> s;
   auto stencil_s = [&]() -> const Stencil<Shape::stencil_size>& { return s; };
-  if constexpr (evaluates_lanes<Shape>()) {
+  auto one = [&](std::size_t p) {
+    if (!usable(p, [&] { return shape.inside(p); })) return;
+    shape.evaluate(p, s);
+    visit(p, entries_of(s), stencil_s, -1.0);
+  };
+  if constexpr (!lanes && !hooked) {
+#pragma omp for schedule(static)
+    for (std::size_t p = begin; p < end; ++p) one(p);
+  } else {
+    // The static schedule's block, kLanes at a time (parallel.hpp: static_block).
     const auto [first, last] = static_block(begin, end);
-    typename Shape::LaneBatch batch;
+    [[maybe_unused]] typename LaneBatchOf<Shape>::type batch;
     for (std::size_t p0 = first; p0 < last; p0 += kLanes) {
       const int count = int(std::min<std::size_t>(kLanes, last - p0));
-      shape.compute_lanes(p0, count, batch, for_scan);
-      const double* bounds = shape.lane_gradient_bounds(batch);
-      if constexpr (!std::is_same_v<OnLanes, NoLaneHook>) on_lanes(p0, count, bounds);
+      const double* bounds = nullptr;
+      if constexpr (lanes) {
+        shape.compute_lanes(p0, count, batch, for_scan);
+        bounds = shape.lane_gradient_bounds(batch);
+      }
+      if constexpr (hooked) on_lanes(p0, count, bounds);
       for (int l = 0; l < count; ++l) {
         const std::size_t p = p0 + std::size_t(l);
-        if (!usable(p, [&] { return shape.lane_inside(batch, l); })) continue;
-        bool listed = false;
-        auto stencil_of = [&]() -> const Stencil<Shape::stencil_size>& {
-          if (!listed) list_lane(shape, batch, l, s);
-          listed = true;
-          return s;
-        };
-        visit(p, [&](auto&& f) { shape.for_each_lane_entry(batch, l, f); }, stencil_of, bounds ? bounds[l] : -1.0);
+        if constexpr (lanes) {
+          if (!usable(p, [&] { return shape.lane_inside(batch, l); })) continue;
+          bool listed = false;
+          auto stencil_of = [&]() -> const Stencil<Shape::stencil_size>& {
+            if (!listed) list_lane(shape, batch, l, s);
+            listed = true;
+            return s;
+          };
+          visit(p, [&](auto&& f) { shape.for_each_lane_entry(batch, l, f); }, stencil_of, bounds ? bounds[l] : -1.0);
+        } else {
+          one(p);
+        }
       }
     }
 #pragma omp barrier
-  } else {
-    auto one = [&](std::size_t p) {
-      if (!usable(p, [&] { return shape.inside(p); })) return;
-      shape.evaluate(p, s);
-      visit(p, entries_of(s), stencil_s, -1.0);
-    };
-    if constexpr (!std::is_same_v<OnLanes, NoLaneHook>) {
-      // The static schedule's block, kLanes at a time (parallel.hpp: static_block).
-      const auto [first, last] = static_block(begin, end);
-      for (std::size_t p0 = first; p0 < last; p0 += kLanes) {
-        const std::size_t stop = std::min<std::size_t>(p0 + kLanes, last);
-        on_lanes(p0, int(stop - p0), nullptr);
-        for (std::size_t p = p0; p < stop; ++p) one(p);
-      }
-#pragma omp barrier
-    } else {
-#pragma omp for schedule(static)
-      for (std::size_t p = begin; p < end; ++p) one(p);
-    }
   }
 }
 

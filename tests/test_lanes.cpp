@@ -190,6 +190,13 @@ TEST(GimpLanes, EveryBuildGivesTheScalarStencilsBitForBit) {
   }
   P.position[0] = grid.origin + grid.h * Vec2(0.25, 0.25);  // on the edges' limit
   P.position[1] = grid.origin + grid.h * Vec2(grid.cells_x - 0.25, 3.5);  // half-way between nodes
+  // Centres whose distance x - x_g to a node is, in floating point, exactly
+  // an end of a piece of the weight (l = h/4), where the pieces on either
+  // side round differently: the first test that holds must pick the piece.
+  // d = l and -l from node 6, h - l and -h + l from node 4.
+  const double ends[4] = {0.012500000000000056, -0.012499999999999945, -0.06249999999999997, -0.13749999999999998};
+  const std::size_t end_particles[4] = {2, 4, 5, 7};  // half-size h/4
+  for (int k = 0; k < 4; ++k) P.position[end_particles[k]] = Vec2(ends[k], grid.origin.y() + 5.5 * grid.h);
   ASSERT_FALSE(mpmvv::testing::lane_builds_of_this_cpu().empty());
   for (LaneBuild build : mpmvv::testing::lane_builds_of_this_cpu()) {
     SCOPED_TRACE(mpmvv::name(build));

@@ -10,31 +10,34 @@ namespace {
 
 using namespace lanes::MPMVV_LANE_BUILD_NS;
 
-// gimp_weight_1d of each lane: the last piece first, then each earlier piece
-// where its test holds, so that the first test that holds decides, as in
-// the scalar chain of ifs.
+// gimp_weight_1d of each lane. Every piece of it is w = c + a / q and
+// dw = b / r (1 - x / h as 1 + (-x) / h, the same number), so each lane picks
+// its piece's c, a, q, b and r (the last piece first, then each earlier one
+// where its test holds: the first test that holds decides, as in the scalar
+// chain of ifs) and two divisions serve every piece: the scalar operations,
+// so the same bits, for a quarter of the divisions.
 template <class Lanes, class Mask>
 MPMVV_LANE_INLINE void gimp_1d(const Lanes& d, double h, const Lanes& l, Lanes& w, Lanes& dw) {
-  const Lanes zero = {};
+  const Lanes zero = {}, one = zero + 1.0, h_lanes = zero + h;
+  const Lanes hl = h * l, two_hl = 2.0 * h * l, four_hl = 4.0 * h * l;
   Lanes s = h + l - d;
-  w = s * s / (4.0 * h * l);
-  dw = -s / (2.0 * h * l);
-  Mask m = d <= h - l;
-  w = m ? 1.0 - d / h : w;
-  dw = m ? zero + -1.0 / h : dw;
-  m = d <= l;
-  w = m ? 1.0 - (d * d + l * l) / (2.0 * h * l) : w;
-  dw = m ? -d / (h * l) : dw;
-  m = d <= -l;
-  w = m ? 1.0 + d / h : w;
-  dw = m ? zero + 1.0 / h : dw;
-  m = d <= -h + l;
+  Lanes c = zero, a = s * s, q = four_hl, b = -s, r = two_hl;
+  auto pick = [&](const Mask& m, const Lanes& c_m, const Lanes& a_m, const Lanes& q_m, const Lanes& b_m,
+                  const Lanes& r_m) {
+    c = m ? c_m : c;
+    a = m ? a_m : a;
+    q = m ? q_m : q;
+    b = m ? b_m : b;
+    r = m ? r_m : r;
+  };
+  pick(d <= h - l, one, -d, h_lanes, zero - 1.0, h_lanes);
+  pick(d <= l, one, -(d * d + l * l), two_hl, -d, hl);
+  pick(d <= -l, one, d, h_lanes, one, h_lanes);
   s = h + l + d;
-  w = m ? s * s / (4.0 * h * l) : w;
-  dw = m ? s / (2.0 * h * l) : dw;
-  m = (d <= -h - l) | (d > h + l);
-  w = m ? zero : w;
-  dw = m ? zero : dw;
+  pick(d <= -h + l, zero, s * s, four_hl, s, two_hl);
+  const Mask outside = (d <= -h - l) | (d > h + l);
+  w = outside ? zero : c + a / q;
+  dw = outside ? zero : b / r;
 }
 
 struct GimpKernel {
