@@ -1,5 +1,6 @@
 // The results file written by `mpmvv run` holds what reports/results-format.md
-// documents, for a completed run and for a run the solver stopped.
+// documents, for a completed run and for a run the solver stopped; and the
+// HDF5 writer under it gives the bytes HDF5 itself would.
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
@@ -206,4 +207,117 @@ TEST(ResultsFile, ACaseThatCannotFitIsRefusedBeforeItStarts) {
   EXPECT_NE(text.find("use fewer cells, particles per direction or threads"), std::string::npos) << text;
   EXPECT_FALSE(fs::exists(out));
   EXPECT_EQ(run_mpmvv("-t 100000 --set cells=32 --set end_time=0.01 -o " + scratch("threads.h5").string()), 2);
+}
+
+namespace {
+
+std::string bytes_of(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// The same content for every file the tests below compare: attributes, a
+// dataset written whole and a particle-sized one written by rows.
+constexpr std::size_t kRows = 3 * (std::size_t(1) << 16) + 17;  // crosses write_rows' blocks
+
+double row_value(std::size_t row, std::size_t k) { return 0.5 * double(row) - 3.0 * double(k) + 1e-3; }
+
+void fill_content(mpmvv::h5::Group& root, bool by_rows) {
+  root.set_attribute("status", "completed");
+  root.set_attribute("steps", std::int64_t(123));
+  root.write("time", std::vector<double>{0.1, 0.2, 0.3}, {3});
+  mpmvv::h5::Group g = root.create_group("particles");
+  if (by_rows) {
+    g.write_rows("position", {kRows, 2}, [](std::size_t first, std::size_t count, double* out) {
+      for (std::size_t r = first; r < first + count; ++r)
+        for (std::size_t k = 0; k < 2; ++k) *out++ = row_value(r, k);
+    });
+  } else {
+    std::vector<double> whole(2 * kRows);
+    for (std::size_t r = 0; r < kRows; ++r)
+      for (std::size_t k = 0; k < 2; ++k) whole[2 * r + k] = row_value(r, k);
+    g.write("position", whole, {kRows, 2});
+  }
+}
+
+}  // namespace
+
+// save() writes the buffer HDF5 hands over as the file closes; it must be the
+// file H5Fget_file_image copies out of the same in-memory file (the way the
+// image was taken before, at twice the memory).
+TEST(Hdf5File, SavedFileIsTheImageHdf5CopiesOut) {
+  const fs::path saved = scratch("handed-over.h5");
+  {
+    mpmvv::h5::File file = mpmvv::h5::File::create(saved.string());
+    {
+      mpmvv::h5::Group root = file.root();
+      fill_content(root, false);
+    }
+    file.save();
+  }
+  // The same file, built with the same properties but no callbacks, copied out.
+  std::string copied;
+  {
+    const hid_t fcpl = H5Pcreate(H5P_FILE_CREATE);
+    ASSERT_GE(H5Pset_link_creation_order(fcpl, H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED), 0);
+    const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+    ASSERT_GE(H5Pset_fapl_core(fapl, std::size_t(1) << 20, 0), 0);
+    ASSERT_GE(H5Pset_fclose_degree(fapl, H5F_CLOSE_STRONG), 0);
+    const hid_t id = H5Fcreate(scratch("copied.h5").c_str(), H5F_ACC_TRUNC, fcpl, fapl);
+    ASSERT_GE(id, 0);
+    {
+      mpmvv::h5::Group root(mpmvv::h5::Handle(H5Gopen2(id, "/", H5P_DEFAULT), H5Gclose), "/");
+      fill_content(root, false);
+    }
+    ASSERT_GE(H5Fflush(id, H5F_SCOPE_GLOBAL), 0);
+    const ssize_t size = H5Fget_file_image(id, nullptr, 0);
+    ASSERT_GT(size, 0);
+    copied.resize(std::size_t(size));
+    ASSERT_EQ(H5Fget_file_image(id, copied.data(), copied.size()), size);
+    ASSERT_GE(H5Fclose(id), 0);
+    ASSERT_GE(H5Pclose(fapl), 0);
+    ASSERT_GE(H5Pclose(fcpl), 0);
+  }
+  const std::string written = bytes_of(saved);
+  ASSERT_EQ(written.size(), copied.size());
+  EXPECT_TRUE(written == copied) << "the saved file differs from HDF5's image of it";
+}
+
+// A dataset written a block of rows at a time is the file a whole write gives.
+TEST(Hdf5File, RowsWrittenInBlocksGiveTheBytesOfAWholeWrite) {
+  std::string files[2];
+  const fs::path by_rows_path = scratch("by-rows.h5");
+  for (const bool by_rows : {false, true}) {
+    const fs::path p = by_rows ? by_rows_path : scratch("whole.h5");
+    mpmvv::h5::File file = mpmvv::h5::File::create(p.string());
+    {
+      mpmvv::h5::Group root = file.root();
+      fill_content(root, by_rows);
+    }
+    file.save();
+    files[by_rows] = bytes_of(p);
+  }
+  ASSERT_GT(files[0].size(), 2 * kRows * sizeof(double));
+  EXPECT_TRUE(files[0] == files[1]);
+  const mpmvv::h5::File file = mpmvv::h5::File::open_read(by_rows_path.string());
+  std::vector<hsize_t> dims;
+  const std::vector<double> read = file.root().open_group("particles").read_doubles("position", &dims);
+  ASSERT_EQ(dims, (std::vector<hsize_t>{kRows, 2}));
+  EXPECT_EQ(read[2 * (kRows - 1) + 1], row_value(kRows - 1, 1));
+}
+
+// Saving while a group is open would leave HDF5 holding the file open; it is
+// refused with the reason, and nothing is written.
+TEST(Hdf5File, SavingWithAGroupOpenIsRefused) {
+  const fs::path p = scratch("open-group.h5");
+  mpmvv::h5::File file = mpmvv::h5::File::create(p.string());
+  mpmvv::h5::Group root = file.root();
+  root.set_attribute("status", "completed");
+  try {
+    file.save();
+    FAIL() << "saved with a group open";
+  } catch (const std::logic_error& e) {
+    EXPECT_NE(std::string(e.what()).find("still open"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(p));
 }

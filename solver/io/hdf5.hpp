@@ -4,7 +4,10 @@
 
 #include <hdf5.h>
 
+#include <cstddef>
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -22,6 +25,12 @@ class Handle {
   Handle& operator=(Handle&& o) noexcept;
   ~Handle();
   hid_t get() const { return id_; }
+  // Gives up ownership: the caller closes the id.
+  hid_t release() {
+    const hid_t id = id_;
+    id_ = H5I_INVALID_HID;
+    return id;
+  }
 
  private:
   hid_t id_ = H5I_INVALID_HID;
@@ -50,6 +59,12 @@ class Group {
   // Row-major data with the given dimensions (their product is data.size()).
   void write(const std::string& name, const std::vector<double>& data, const std::vector<hsize_t>& dims);
   void write(const std::string& name, const std::vector<std::int64_t>& data, const std::vector<hsize_t>& dims);
+  // A dataset of dims[0] rows written a block of rows at a time, so that a
+  // large array is never staged whole: fill(first, count, out) writes rows
+  // [first, first + count) row-major to out (count * the product of the
+  // other dims doubles).
+  using RowFiller = std::function<void(std::size_t first, std::size_t count, double* out)>;
+  void write_rows(const std::string& name, const std::vector<hsize_t>& dims, const RowFiller& fill);
 
   double attribute_double(const std::string& name) const;
   std::vector<double> attribute_doubles(const std::string& name) const;
@@ -62,6 +77,9 @@ class Group {
   std::string path_;
 };
 
+// Where the core driver's buffer lands when HDF5 hands it over (hdf5.cpp).
+struct CoreImage;
+
 class File {
  public:
   // A new file, built in memory (HDF5's core driver) and written to `path`
@@ -70,17 +88,25 @@ class File {
   // and crashes on, when the library shuts down.
   static File create(const std::string& path);
   static File open_read(const std::string& path);
+  File(File&&) noexcept;
+  File& operator=(File&&) noexcept;
+  ~File();
   Group root() const;
   const std::string& path() const { return path_; }
-  // Writes the file's image to its path (create) or flushes it (open_read).
-  void save() const;
+  // Closes a created file and writes it to its path. HDF5 hands the core
+  // driver's buffer over as the file closes, so the file's bytes are never
+  // held twice (a copy of the image would double the memory of a run whose
+  // particles are most of its file). Every group opened from the file must
+  // be closed before; the file is unusable after.
+  void save();
 
  private:
-  File(Handle handle, std::string path, bool in_memory = false)
-      : handle_(std::move(handle)), path_(std::move(path)), in_memory_(in_memory) {}
+  File(Handle handle, std::string path, std::unique_ptr<CoreImage> image);
+  // Declared first so that it outlives the handle: closing the file hands
+  // the buffer to it. Null for open_read.
+  std::unique_ptr<CoreImage> image_;
   Handle handle_;
   std::string path_;
-  bool in_memory_;
 };
 
 }  // namespace mpmvv::h5

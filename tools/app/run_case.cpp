@@ -96,10 +96,9 @@ const char* run_status(const RunOutcome& o, const RunHealth& health) {
   return o.failure_reason == kInterrupted ? kInterrupted : "failed";
 }
 
-void write_results_file(const std::string& path, const RunRequest& request, const Config& config,
-                        const SceneCase& scene, const RunOutcome& o, const RunHealth& health, Fault fault) {
-  h5::File file = h5::File::create(path);
-  h5::Group root = file.root();
+// Everything a results file holds, under its root group.
+void write_run(h5::Group root, const RunRequest& request, const Config& config, const SceneCase& scene,
+               const RunOutcome& o, const RunHealth& health, Fault fault) {
   // Every scene key as an attribute of its own, then what the run measured.
   for (const KeySpec& k : config.specs()) set_key_attribute(root, k.name, config.value(k.name));
   root.set_attribute("scene", config.scene());
@@ -156,6 +155,12 @@ void write_results_file(const std::string& path, const RunRequest& request, cons
     h5::Group g = root.create_group("measurements");
     for (const auto& [name, value] : m) g.set_attribute(name, value);
   }
+}
+
+void write_results_file(const std::string& path, const RunRequest& request, const Config& config,
+                        const SceneCase& scene, const RunOutcome& o, const RunHealth& health, Fault fault) {
+  h5::File file = h5::File::create(path);
+  write_run(file.root(), request, config, scene, o, health, fault);  // the root group closes on return
   file.save();
 }
 

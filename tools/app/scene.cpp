@@ -222,37 +222,44 @@ void write_errors(h5::Group& root, const ErrorTable& errors, const std::string& 
   for (const auto& [name, values] : errors.columns) e.write(name, values, {values.size()});
 }
 
+// Each field is written a block of rows at a time from the particle arrays
+// (h5::Group::write_rows): staging the whole set would add 12 doubles a
+// particle (20 with corner domains) to the run's memory at its last moment.
 void write_particles(h5::Group& root, const Particles& P) {
   h5::Group g = root.create_group("particles");
   const std::size_t n = P.size();
-  std::vector<double> X(2 * n), x(2 * n), v(2 * n), V(n), J(n), F(4 * n);
-  for (std::size_t p = 0; p < n; ++p) {
-    for (int k = 0; k < 4; ++k) F[4 * p + std::size_t(k)] = P.deformation_gradient[p](k / 2, k % 2);
-    X[2 * p] = P.reference_position[p].x();
-    X[2 * p + 1] = P.reference_position[p].y();
-    x[2 * p] = P.position[p].x();
-    x[2 * p + 1] = P.position[p].y();
-    v[2 * p] = P.velocity[p].x();
-    v[2 * p + 1] = P.velocity[p].y();
-    V[p] = P.volume[p];
-    J[p] = determinant(P.deformation_gradient[p]);
-  }
-  g.write("reference_position", X, {n, 2});
-  g.write("position", x, {n, 2});
-  g.write("velocity", v, {n, 2});
-  g.write("volume", V, {n});
-  g.write("J", J, {n});
-  g.write("deformation_gradient", F, {n, 2, 2});
+  auto vectors = [&](const auto& field) {
+    return [&field](std::size_t first, std::size_t count, double* out) {
+      for (std::size_t p = first; p < first + count; ++p, out += 2) {
+        out[0] = field[p].x();
+        out[1] = field[p].y();
+      }
+    };
+  };
+  auto scalars = [](const auto& value) {
+    return [&value](std::size_t first, std::size_t count, double* out) {
+      for (std::size_t p = first; p < first + count; ++p) *out++ = value(p);
+    };
+  };
+  g.write_rows("reference_position", {n, 2}, vectors(P.reference_position));
+  g.write_rows("position", {n, 2}, vectors(P.position));
+  g.write_rows("velocity", {n, 2}, vectors(P.velocity));
+  g.write_rows("volume", {n}, scalars([&](std::size_t p) { return P.volume[p]; }));
+  g.write_rows("J", {n}, scalars([&](std::size_t p) { return determinant(P.deformation_gradient[p]); }));
+  g.write_rows("deformation_gradient", {n, 2, 2}, [&](std::size_t first, std::size_t count, double* out) {
+    for (std::size_t p = first; p < first + count; ++p)
+      for (int k = 0; k < 4; ++k) *out++ = P.deformation_gradient[p](k / 2, k % 2);
+  });
   // Corner domains (cpdi_domain = "corners") are whole quadrilaterals, not
   // F_p times the reference half-vectors: store their corners so a reader can
   // draw the domains the transfers used, counter-clockwise from (-1, -1).
   if (P.domain_corner.size() == 4 * n && n > 0) {
-    std::vector<double> c(8 * n);
-    for (std::size_t k = 0; k < 4 * n; ++k) {
-      c[2 * k] = P.domain_corner[k].x();
-      c[2 * k + 1] = P.domain_corner[k].y();
-    }
-    g.write("domain_corners", c, {n, 4, 2});
+    g.write_rows("domain_corners", {n, 4, 2}, [&](std::size_t first, std::size_t count, double* out) {
+      for (std::size_t k = 4 * first; k < 4 * (first + count); ++k, out += 2) {
+        out[0] = P.domain_corner[k].x();
+        out[1] = P.domain_corner[k].y();
+      }
+    });
   }
 }
 
