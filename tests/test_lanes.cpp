@@ -197,6 +197,16 @@ TEST(GimpLanes, EveryBuildGivesTheScalarStencilsBitForBit) {
   const double ends[4] = {0.012500000000000056, -0.012499999999999945, -0.06249999999999997, -0.13749999999999998};
   const std::size_t end_particles[4] = {2, 4, 5, 7};  // half-size h/4
   for (int k = 0; k < 4; ++k) P.position[end_particles[k]] = Vec2(ends[k], grid.origin.y() + 5.5 * grid.h);
+  // One particle per cell and direction (l = h/2, where h - l = l): d = l
+  // from node 6, -l from node 7, -h - l from node 3 (the support's end,
+  // outside) and a centre on node 6.
+  const double half_ends[4] = {-0.024999999999999932, -0.024999999999999946, -0.27499999999999997,
+                               grid.origin.x() + 6.0 * grid.h};
+  for (int k = 0; k < 4; ++k) {
+    const std::size_t p = 10 + std::size_t(k);
+    P.half_size[p] = Vec2(0.5 * grid.h, 0.5 * grid.h);
+    P.position[p] = Vec2(half_ends[k], grid.origin.y() + (k == 3 ? 6.0 : 5.5) * grid.h);
+  }
   ASSERT_FALSE(mpmvv::testing::lane_builds_of_this_cpu().empty());
   for (LaneBuild build : mpmvv::testing::lane_builds_of_this_cpu()) {
     SCOPED_TRACE(mpmvv::name(build));
