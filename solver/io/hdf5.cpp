@@ -62,12 +62,17 @@ void write_attribute(hid_t parent, const std::string& name, hid_t type, hid_t sp
   check_status(H5Awrite(attr.get(), type, data), "H5Awrite", what);
 }
 
+Handle create_dataset(hid_t parent, const std::string& name, hid_t type, const Handle& space,
+                      const std::string& what) {
+  return Handle(check(H5Dcreate2(parent, name.c_str(), type, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+                      "H5Dcreate2", what),
+                H5Dclose);
+}
+
 void write_dataset(hid_t parent, const std::string& name, hid_t type, const std::vector<hsize_t>& dims,
                    const void* data, const std::string& what) {
   Handle space = simple_space(dims, what);
-  Handle set(check(H5Dcreate2(parent, name.c_str(), type, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
-                   "H5Dcreate2", what),
-             H5Dclose);
+  Handle set = create_dataset(parent, name, type, space, what);
   check_status(H5Dwrite(set.get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), "H5Dwrite", what);
 }
 
@@ -180,10 +185,7 @@ void Group::write_rows(const std::string& name, const std::vector<hsize_t>& dims
   const std::string what = join(path_, name);
   if (dims.empty()) throw std::invalid_argument("HDF5 dataset " + what + " written by rows has no dimensions");
   Handle space = simple_space(dims, what);
-  Handle set(check(H5Dcreate2(id(), name.c_str(), H5T_NATIVE_DOUBLE, space.get(), H5P_DEFAULT, H5P_DEFAULT,
-                              H5P_DEFAULT),
-                   "H5Dcreate2", what),
-             H5Dclose);
+  Handle set = create_dataset(id(), name, H5T_NATIVE_DOUBLE, space, what);
   const hsize_t rows = dims[0];
   hsize_t row_size = 1;
   for (std::size_t k = 1; k < dims.size(); ++k) row_size *= dims[k];
@@ -261,7 +263,7 @@ std::vector<double> Group::read_doubles(const std::string& name, std::vector<hsi
 // (H5Pset_file_image_callbacks) so that HDF5 hands it over when the file
 // closes instead of freeing it: by then the library has flushed every
 // object and cleared the superblock's status flags, so the buffer's first
-// `size` bytes are the file exactly as H5Fget_file_image would copy it
+// bytes, as many as the image had before the close, are the file exactly as H5Fget_file_image would copy it
 // (tests/test_results_file.cpp checks this).
 namespace {
 
@@ -300,7 +302,6 @@ void* remap_image(void* image, std::size_t size) {
 
 struct CoreImage {
   void* data = nullptr;  // set when the file closes
-  std::size_t size = 0;  // the image's length (HDF5's end of allocation), read before the close
   ~CoreImage() { unmap_image(data); }
 };
 
@@ -371,12 +372,12 @@ void File::save() {
     throw std::logic_error("HDF5 file " + path_ + " saved with " + std::to_string(open_objects - 1) +
                            " of its objects still open");
   check_status(H5Fflush(id, H5F_SCOPE_GLOBAL), "H5Fflush", path_);
+  // The image's length (HDF5's end of allocation), which the close leaves as it is.
   const ssize_t size = H5Fget_file_image(id, nullptr, 0);
   if (size < 0) fail("H5Fget_file_image", path_);
-  image_->size = std::size_t(size);
   check_status(H5Fclose(handle_.release()), "H5Fclose", path_);
   if (image_->data == nullptr) fail("H5Fclose (the core driver's buffer was not handed over)", path_);
-  io::write_file(path_, image_->data, image_->size);
+  io::write_file(path_, image_->data, std::size_t(size));
   image_.reset();
 }
 

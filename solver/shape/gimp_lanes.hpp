@@ -1,8 +1,8 @@
 // The uGIMP stencil of eight particles at once (lanes.hpp): the same weights
 // and gradients as GimpShapeT::evaluate (gimp.hpp, eqs. 1.91-1.92 of
 // 002_c3305cb8b1bc1490.txt and their tensor product), plane strain, to the
-// last bit. Each of the six pieces of the 1D weight is formed in every lane
-// and the one the scalar code's first true test picks is kept, so the lanes
+// last bit. Each lane picks the operands of the piece of the 1D weight that
+// the scalar code's first true test picks (gimp_lanes.cpp), so the lanes
 // need no branch.
 #pragma once
 

@@ -228,11 +228,12 @@ void write_errors(h5::Group& root, const ErrorTable& errors, const std::string& 
 void write_particles(h5::Group& root, const Particles& P) {
   h5::Group g = root.create_group("particles");
   const std::size_t n = P.size();
-  auto vectors = [&](const auto& field) {
-    return [&field](std::size_t first, std::size_t count, double* out) {
-      for (std::size_t p = first; p < first + count; ++p, out += 2) {
-        out[0] = field[p].x();
-        out[1] = field[p].y();
+  // Rows of `per_row` 2-vectors from a field that holds them one row after another.
+  auto vectors = [](const auto& field, std::size_t per_row = 1) {
+    return [&field, per_row](std::size_t first, std::size_t count, double* out) {
+      for (std::size_t k = per_row * first; k < per_row * (first + count); ++k, out += 2) {
+        out[0] = field[k].x();
+        out[1] = field[k].y();
       }
     };
   };
@@ -254,12 +255,7 @@ void write_particles(h5::Group& root, const Particles& P) {
   // F_p times the reference half-vectors: store their corners so a reader can
   // draw the domains the transfers used, counter-clockwise from (-1, -1).
   if (P.domain_corner.size() == 4 * n && n > 0) {
-    g.write_rows("domain_corners", {n, 4, 2}, [&](std::size_t first, std::size_t count, double* out) {
-      for (std::size_t k = 4 * first; k < 4 * (first + count); ++k, out += 2) {
-        out[0] = P.domain_corner[k].x();
-        out[1] = P.domain_corner[k].y();
-      }
-    });
+    g.write_rows("domain_corners", {n, 4, 2}, vectors(P.domain_corner, 4));
   }
 }
 
