@@ -89,6 +89,8 @@ class AxisAlignedClosedFormField final : public ForceField {
     }
   }
 
+  std::size_t bytes() const override { return bytes_held(sin_) + bytes_held(cos_); }
+
  private:
   double wavenumber() const {
     return (motion_.one_dimensional ? 2.0 : 1.0) * std::numbers::pi / motion_.length;

@@ -122,6 +122,8 @@ class ExpandingRingClosedFormField final : public ForceField {
     }
   }
 
+  std::size_t bytes() const override { return bytes_held(point_); }
+
  private:
   struct Point {
     double R, f, df, ddf;  // the reference radius and the profile f(R) with its derivatives

@@ -40,6 +40,8 @@ class ForceField {
   virtual void place(std::size_t count, const std::vector<std::size_t>& index, const std::vector<Vec2>& at) = 0;
   // b at every point [m/s^2].
   virtual void evaluate(double t, std::vector<Vec2>& b) const = 0;
+  // The bytes the field keeps for its points.
+  virtual std::size_t bytes() const = 0;
   // All points placed anew.
   void prepare(const std::vector<Vec2>& points) { place(points.size(), all_indices(points.size()), points); }
 
@@ -67,6 +69,7 @@ class DerivedForceField final : public ForceField {
     place_points(points_, count, index, at);
   }
   void evaluate(double t, std::vector<Vec2>& b) const override { solution_->body_forces(t, points_, b); }
+  std::size_t bytes() const override { return bytes_held(points_); }
 
  private:
   std::shared_ptr<const ExactSolution> solution_;
@@ -106,6 +109,8 @@ class ManufacturedBodyForce final : public BodyForce {
     for (std::size_t p = previous_count; p < P.size(); ++p) particles.push_back(p);
     place_particles(P, particles);
   }
+
+  std::size_t bytes() const override { return field_->bytes() + bytes_held(weight_) + bytes_held(at_points_); }
 
   void evaluate(double t, const Particles& P, std::vector<Vec2>& b) const override {
     const std::size_t n = P.size();

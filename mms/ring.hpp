@@ -216,22 +216,25 @@ class RingMms {
 };
 
 // The closed form as a force field (force_field.hpp), for the neo-Hookean
-// ring. The radial factors and the direction of each point never change, so
-// they are kept per point; a step then costs one time-function evaluation and
-// one sin/cos pair per point. tests/test_manufactured.cpp shows it equals the
-// derived force to round-off.
+// ring. It keeps each point's reference radius and direction (24 bytes a
+// point) and forms the radial factors h, h' and h'' from the radius at every
+// evaluation, by the same expressions a cache of them would hold (48 bytes a
+// point): three divisions and the profile's polynomials a point and step.
+// A step then costs those, one time-function evaluation and one sin/cos pair
+// per point. tests/test_manufactured.cpp shows it equals the derived force to
+// round-off.
 class RingClosedFormField final : public ForceField {
  public:
   explicit RingClosedFormField(const RingMms& mms) : mms_(mms) {}
 
   void place(std::size_t count, const std::vector<std::size_t>& index, const std::vector<Vec2>& at) override {
-    radial_.resize(count);
+    radius_.resize(count);
     direction_.resize(count);
     const std::size_t n = index.size();
 #pragma omp parallel for schedule(static)
     for (std::size_t k = 0; k < n; ++k) {
       const Vec2& X = at[k];
-      radial_[index[k]] = mms_.radial(X.norm());
+      radius_[index[k]] = X.norm();
       direction_[index[k]] = X / X.norm();
     }
   }
@@ -242,25 +245,35 @@ class RingClosedFormField final : public ForceField {
   // the scalar formula above in its last bits only.
   void evaluate(double t, std::vector<Vec2>& b) const override {
     constexpr std::size_t kBlock = 256;
-    const std::size_t n = radial_.size();
+    const std::size_t n = radius_.size();
     const RingMms::Temporal q = mms_.temporal(t);
 #pragma omp parallel for schedule(static)
     for (std::size_t first = 0; first < n; first += kBlock) {
       const std::size_t count = std::min(kBlock, n - first);
-      double alpha[kBlock], cos_alpha[kBlock], sin_alpha[kBlock];
-      for (std::size_t k = 0; k < count; ++k) alpha[k] = RingMms::turn(radial_[first + k], q);
+      const double* R = radius_.data() + first;
+      // Array by array, so that the divisions go two or more to an instruction.
+      double h[kBlock], h_prime[kBlock], h_second[kBlock], alpha[kBlock], cos_alpha[kBlock], sin_alpha[kBlock];
+      for (std::size_t k = 0; k < count; ++k) {
+        h[k] = mms_.h(R[k]);
+        h_prime[k] = mms_.h_prime(R[k]);
+        h_second[k] = mms_.h_second(R[k]);
+      }
+      for (std::size_t k = 0; k < count; ++k) alpha[k] = RingMms::turn({R[k], h[k], 0.0, 0.0}, q);
       lane_sincos(count, alpha, sin_alpha, cos_alpha);
       for (std::size_t k = 0; k < count; ++k) {
-        const std::size_t p = first + k;
-        b[p] = mms_.body_force(radial_[p], direction_[p].x(), direction_[p].y(), q, cos_alpha[k], sin_alpha[k]);
+        const Vec2& d = direction_[first + k];
+        b[first + k] = mms_.body_force({R[k], h[k], h_prime[k], h_second[k]}, d.x(), d.y(), q, cos_alpha[k],
+                                       sin_alpha[k]);
       }
     }
   }
 
+  std::size_t bytes() const override { return bytes_held(radius_) + bytes_held(direction_); }
+
  private:
   RingMms mms_;
-  std::vector<RingMms::Radial> radial_;
-  std::vector<Vec2> direction_;  // X / |X|: (cos Theta, sin Theta)
+  std::vector<double> radius_;    // |X|
+  std::vector<Vec2> direction_;   // X / |X|: (cos Theta, sin Theta)
 };
 
 }  // namespace mpmvv::mms

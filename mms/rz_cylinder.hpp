@@ -115,6 +115,8 @@ class RzCylinderClosedFormField final : public ForceField {
     }
   }
 
+  std::size_t bytes() const override { return bytes_held(point_); }
+
  private:
   struct Point {
     double R, q, dq, ddq;  // the radius and the profile q(R) with its derivatives

@@ -90,6 +90,8 @@ class SurfaceTraction final : public BodyForce {
     }
   }
 
+  std::size_t bytes() const override { return bytes_held(particles_) + bytes_held(reference_area_); }
+
   double total_force(double t) const {
     double area = 0.0;
     for (double a : reference_area_) area += a;

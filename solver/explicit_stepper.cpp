@@ -171,7 +171,8 @@ class ExplicitStepper final : public Stepper {
   double bytes_per_particle() const override {
     const std::size_t n = model_.particles.size();
     const std::size_t own = bytes_held(stencils_) + bytes_held(next_position_) + bytes_held(next_corner_) +
-                            bytes_held(step_start_deformation_) + bytes_held(volume_before_);
+                            bytes_held(step_start_deformation_) + bytes_held(volume_before_) +
+                            (body_force_ ? body_force_->bytes() : 0);
     return n ? double(model_.particles.bytes() + own) / double(n) : 0.0;
   }
 

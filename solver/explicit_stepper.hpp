@@ -56,8 +56,8 @@ class Stepper {
   // Wall time per stage of the step so far (stage_times.hpp); zero for a
   // stepper whose stages are not timed.
   const StageTimes& stage_times() const { return stage_times_; }
-  // The bytes the particles' arrays and the stepper's own arrays per particle
-  // hold now, over the particle count.
+  // The bytes the particles' arrays, the stepper's own arrays and its body
+  // force's hold now, over the particle count.
   virtual double bytes_per_particle() const {
     return model_.particles.size() ? double(model_.particles.bytes()) / double(model_.particles.size()) : 0.0;
   }

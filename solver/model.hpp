@@ -90,6 +90,8 @@ class BodyForce {
     prepare(particles);
   }
   virtual void evaluate(double t, const Particles& particles, std::vector<Vec2>& body_force) const = 0;
+  // The bytes it keeps per particle set (Stepper::bytes_per_particle counts them).
+  virtual std::size_t bytes() const { return 0; }
 };
 
 struct Model {

@@ -83,7 +83,8 @@ struct RunOutcome {
   double wall_seconds = 0.0;
   double forcing_seconds = 0.0;
   StageTimes stage_seconds;         // the step's stages (stage_times.hpp), body force apart
-  double bytes_per_particle = 0.0;  // held by the particles and the stepper at the end (Stepper::bytes_per_particle)
+  double bytes_per_particle = 0.0;  // held by the particles, the stepper and its body force at the end
+                                    // (Stepper::bytes_per_particle)
   double dt_first = std::numeric_limits<double>::quiet_NaN();  // from the CFL condition
   double dt_min = std::numeric_limits<double>::quiet_NaN();
   double dt_max = std::numeric_limits<double>::quiet_NaN();

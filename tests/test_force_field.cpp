@@ -36,6 +36,7 @@ class FunctionField final : public ForceField {
   void evaluate(double, std::vector<Vec2>& b) const override {
     for (std::size_t k = 0; k < points_.size(); ++k) b[k] = f_(points_[k]);
   }
+  std::size_t bytes() const override { return mpmvv::bytes_held(points_); }
 
  private:
   Field f_;
@@ -234,4 +235,22 @@ TEST(ForceQuadrature, ASplitPlacesOnlyWhatItChanged) {
       EXPECT_EQ(a[p].y(), b[p].y()) << "particle " << p << ", " << mpmvv::mms::to_string(q);
     }
   }
+}
+
+// What a force keeps for its particles (BodyForce::bytes, which the stepper's
+// bytes per particle counts): the ring's closed form a radius and a direction
+// per point (8 + 16 bytes); the domain rule four points a particle, with a
+// weight (8) and the force (16) at each.
+TEST(ForceQuadrature, BytesCountWhatTheFieldKeepsPerPoint) {
+  const mpmvv::mms::RingMms ring(mpmvv::mms::RingParameters{});
+  const std::vector<Vec2> X = {{0.8, 0.1}, {0.9, -0.3}, {-0.2, 1.0}, {0.5, 0.7}, {-1.1, -0.2}};
+  const Particles P = particles_at(X, Vec2(0.03, 0.05));
+  ManufacturedBodyForce centroid(std::make_shared<mpmvv::mms::RingClosedFormField>(ring), ForceQuadrature::centroid,
+                                 Geometry::plane_strain);
+  centroid.prepare(P);
+  EXPECT_EQ(centroid.bytes(), 24u * X.size());
+  ManufacturedBodyForce domain(std::make_shared<mpmvv::mms::RingClosedFormField>(ring), ForceQuadrature::domain,
+                               Geometry::plane_strain);
+  domain.prepare(P);
+  EXPECT_EQ(domain.bytes(), 4u * (24u + 8u + 16u) * X.size());
 }

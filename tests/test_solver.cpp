@@ -1281,6 +1281,26 @@ TEST(Stepper, BytesPerParticleCountEveryArrayItHolds) {
   EXPECT_EQ(musl->bytes_per_particle(), 168.0);
 }
 
+// A body force's own arrays count too (BodyForce::bytes): here 40 bytes a
+// particle beside linear MPM's 136 and the body-force array b_p (16).
+class KeepingBodyForce final : public mpmvv::BodyForce {
+ public:
+  void prepare(const Particles& P) override { kept_.assign(5 * P.size(), 0.0); }
+  void evaluate(double, const Particles&, std::vector<Vec2>& b) const override {
+    for (Vec2& v : b) v.setZero();
+  }
+  std::size_t bytes() const override { return mpmvv::bytes_held(kept_); }
+
+ private:
+  std::vector<double> kept_;
+};
+
+TEST(Stepper, BytesPerParticleCountWhatTheBodyForceKeeps) {
+  auto stepper = mpmvv::make_stepper(disk_model(Method::linear), SolverOptions{Method::linear, Scheme::usl},
+                                     MaterialModel{kSolid}, std::make_shared<KeepingBodyForce>());
+  EXPECT_EQ(stepper->bytes_per_particle(), 136.0 + 16.0 + 40.0);
+}
+
 // A stepper whose stage gives up at its third step, as a system of rest
 // points that does not factor does.
 class GivingUpStepper final : public Stepper {

@@ -6,7 +6,7 @@
 //   mpmvv-bench-throughput [--cells 256] [--end-time 0.1] [--repeats 3] [--threads 1,2] [--set KEY=VALUE]
 //
 // Beside the rate, each stage's wall time per particle-step (stage_times.hpp)
-// and the bytes the particles and the stepper hold per particle.
+// and the bytes the particles, the stepper and its body force hold per particle.
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -42,8 +42,9 @@ int main(int argc, char** argv) {
              "{}\n",
              cells, scheme, end_time, extra.empty() ? "" : ", " + fmt::format("{}", fmt::join(extra, ", ")), repeats);
   fmt::print("ns: wall time per particle-step, then the same for each stage (stage_times.hpp; other: set-up, the "
-             "time loop, output, ledgers);\nbytes: what the particles and the stepper hold per particle; CPDI and uGIMP "
-             "stencils by the {} build of the lane kernels (solver/lanes.hpp; MPMVV_LANE_BUILD names another)\n",
+             "time loop, output, ledgers);\nbytes: what the particles, the stepper and its body force hold per "
+             "particle; CPDI and uGIMP stencils by the {} build of the lane kernels (solver/lanes.hpp; "
+             "MPMVV_LANE_BUILD names another)\n",
              mpmvv::name(mpmvv::lane_build()));
   fmt::print("{:>10} {:>7} {:>9} {:>6} {:>16} {:>7} | {:>6} {:>6} {:>6} {:>6} {:>6} {:>7} {:>6} | {:>5}\n", "method",
              "threads", "particles", "steps", "particle-steps/s", "ns", "map", "grid", "update", "stress", "scan",
