@@ -23,6 +23,7 @@
 #include "shape/stored_stencils.hpp"
 #include "shape/total_lagrangian.hpp"
 #include "monitors.hpp"
+#include "io/state_archive.hpp"
 
 namespace mpmvv {
 
@@ -127,6 +128,27 @@ class ExplicitStepper final : public Stepper {
         if (body_force_) body_force_->update(model_.particles, before, split_parents_);
       }
     }
+  }
+
+  bool restartable() const override { return true; }
+
+  // Besides the particles: what a step leaves for the next (the bulk
+  // viscosity's ratio, the total formulation's tracer references) and what
+  // the faults hold. The rest is rebuilt by the next map or is scratch within
+  // a step; the body force's per-particle factors are prepared again from
+  // the particles read, by the functions that made them.
+  void persist(StateArchive& a) override {
+    Stepper::persist(a);
+    a.field("viscous_ratio", viscous_ratio_);
+    a.field("tracer_reference", tracer_reference_);
+    a.field("held_deformation", held_deformation_);
+    a.field("held_stress", held_stress_);
+    a.field("force_time", force_time_);
+    a.field("first_signal_speed", first_signal_speed_);
+    if (!a.reads()) return;
+    mapped_at_ = kNotMapped;
+    if (body_force_) body_force_->prepare(model_.particles);
+    if (scheme_ == Scheme::musl) next_position_.resize(model_.particles.size());
   }
 
   // With bulk viscosity the fastest grid mode is damped at the ratio xi of the
@@ -773,6 +795,17 @@ std::unique_ptr<Stepper> make_for_geometry(Model model, const SolverOptions& o, 
 }
 
 }  // namespace
+
+void Stepper::persist(StateArchive& a) {
+  a.field("particles", model_.particles);
+  a.field("tracers", model_.tracers);
+  a.field("ledger", ledger_);
+  a.field("forcing_seconds", forcing_seconds_);
+  a.field("stage_seconds", stage_times_);
+  a.field("constraint_reactions", reactions_);
+  a.field("contact_node_force", contact_forces_.node_force);
+  a.field("contact_total", contact_forces_.total);
+}
 
 void check_domain_outlines(const Particles& P, Method method) {
   if (P.domain_first.empty() && P.domain_vertex.empty()) return;

@@ -17,6 +17,8 @@
 
 namespace mpmvv {
 
+class StateArchive;  // io/state_archive.hpp
+
 // Why a particle stops the run.
 struct ParticleFault {
   std::string reason;  // "nan", "non-positive J", "outside grid", "domain too wide" (exact CPDI)
@@ -84,6 +86,16 @@ class Stepper {
   // otherwise). Central differences are stable while dt <= 2 / omega_max.
   virtual double largest_frequency(int /*iterations*/) const { return std::numeric_limits<double>::quiet_NaN(); }
   const EnergyLedger& ledger() const { return ledger_; }
+  // Whether persist() holds all that a step hands to the next, so that a run
+  // continued from a restart file ends with the bits of a run that never
+  // stopped (the explicit steppers; not the implicit one, whose solver keeps
+  // its own).
+  virtual bool restartable() const { return false; }
+  // Writes or reads (io/state_archive.hpp) the state between two steps: the
+  // particles, the tracers, the work done on them and the time spent so far.
+  // Read into a stepper built from the same configuration, it continues the
+  // run: the next prepare_step(t) maps afresh.
+  virtual void persist(StateArchive& archive);
 
  protected:
   explicit Stepper(Model model) : model_(std::move(model)) { fields_.resize(model_.grid.node_count()); }

@@ -69,13 +69,40 @@ struct Particles {
 
   std::size_t size() const { return position.size(); }
 
+  // Calls f(name, array) for every array above: what the bytes count and a
+  // restart file stores (io/state_archive.hpp) are the same list.
+  template <class Self, class F>
+  static void for_each_array(Self& P, F&& f) {
+    f("position", P.position);
+    f("velocity", P.velocity);
+    f("deformation_gradient", P.deformation_gradient);
+    f("volume", P.volume);
+    f("stress", P.stress);
+    f("mass", P.mass);
+    f("reference_volume", P.reference_volume);
+    f("reference_position", P.reference_position);
+    f("half_size", P.half_size);
+    f("domain_axes", P.domain_axes);
+    f("domain_corner", P.domain_corner);
+    f("domain_first", P.domain_first);
+    f("domain_vertex", P.domain_vertex);
+    f("hoop_stretch", P.hoop_stretch);
+    f("hoop_stress", P.hoop_stress);
+    f("affine_velocity", P.affine_velocity);
+    f("body_force", P.body_force);
+  }
+
   // The bytes the arrays hold (their capacity).
   std::size_t bytes() const {
-    return bytes_held(position) + bytes_held(velocity) + bytes_held(deformation_gradient) + bytes_held(volume) +
-           bytes_held(stress) + bytes_held(mass) + bytes_held(reference_volume) + bytes_held(reference_position) +
-           bytes_held(half_size) + bytes_held(domain_axes) + bytes_held(domain_corner) + bytes_held(domain_first) +
-           bytes_held(domain_vertex) + bytes_held(hoop_stretch) + bytes_held(hoop_stress) +
-           bytes_held(affine_velocity) + bytes_held(body_force);
+    std::size_t total = 0;
+    for_each_array(*this, [&](const char*, const auto& v) { total += bytes_held(v); });
+    return total;
+  }
+
+  // Every array, for a restart file (Archive: io/state_archive.hpp).
+  template <class Archive>
+  void persist(Archive& a) {
+    for_each_array(*this, [&](const char* name, auto& v) { a.field(name, v); });
   }
 
   // A_p: the columns span particle p's reference domain about X_p.

@@ -90,6 +90,7 @@ struct RunOutcome {
   double dt_max = std::numeric_limits<double>::quiet_NaN();
   long long frequency_measurements = 0;  // TimeStepRule::stable: how often omega_max was measured
   std::size_t outputs_written = 0;
+  std::vector<double> resumed_at;  // the times the run went on from a restart file (Checkpoints)
 };
 
 class RunObserver {
@@ -124,7 +125,68 @@ using ProgressSink = std::function<void(const Progress&)>;
 std::atomic<bool>& stop_request();
 inline constexpr const char* kInterrupted = "interrupted";  // the failure reason and status of such a run
 
+// Where a run stands between two steps: with the stepper's state
+// (Stepper::persist) and its observer's, what a restart file holds for the
+// run to go on as if it had never stopped.
+struct LoopState {
+  double t = 0.0;
+  double previous_dt = 0.0;  // the central-difference kick's half of the last step
+  std::size_t next_output = 0;
+  // TimeStepRule::stable: the last two measurements of omega_max and when
+  // they were made.
+  double omega_last = 0.0, omega_before = 0.0, t_last = 0.0, t_before = 0.0;
+  double signal_at_measurement = 0.0;
+  long long steps_at_measurement = 0;
+  // So far (RunOutcome).
+  long long steps = 0, particle_steps = 0, frequency_measurements = 0;
+  double dt_first = std::numeric_limits<double>::quiet_NaN();
+  double dt_min = std::numeric_limits<double>::quiet_NaN();
+  double dt_max = std::numeric_limits<double>::quiet_NaN();
+  double wall_seconds = 0.0;       // of the parts run before this one
+  std::vector<double> resumed_at;  // the times the run went on from a restart file
+
+  template <class Archive>
+  void persist(Archive& a) {
+    a.field("t", t);
+    a.field("previous_dt", previous_dt);
+    a.field("next_output", next_output);
+    a.field("omega_last", omega_last);
+    a.field("omega_before", omega_before);
+    a.field("t_last", t_last);
+    a.field("t_before", t_before);
+    a.field("signal_at_measurement", signal_at_measurement);
+    a.field("steps_at_measurement", steps_at_measurement);
+    a.field("steps", steps);
+    a.field("particle_steps", particle_steps);
+    a.field("frequency_measurements", frequency_measurements);
+    a.field("dt_first", dt_first);
+    a.field("dt_min", dt_min);
+    a.field("dt_max", dt_max);
+    a.field("wall_seconds", wall_seconds);
+    a.field("resumed_at", resumed_at);
+  }
+};
+
+// Saving a run's state as it goes, and going on from a saved state.
+struct Checkpoints {
+  // Saves the state between two steps (the caller adds the stepper's and the
+  // observer's); a save that fails is the caller's to report, not a reason
+  // to end the run.
+  std::function<void(const LoopState&)> save;
+  double every_seconds = 0.0;  // wall time between saves; 0: only when the run stops early
+  // The run stops before its first step from this time on, as interrupted,
+  // with its state saved.
+  double pause_at = std::numeric_limits<double>::infinity();
+  // Where to go on from (the stepper and the observer already hold their
+  // saved state); null: from t = 0.
+  const LoopState* resume = nullptr;
+};
+
+// With checkpoints, the state is saved every `every_seconds` and when the run
+// stops early (a signal, pause_at); a run that ends otherwise saves none at
+// its end.
 RunOutcome run_time_loop(Stepper& stepper, const TimeLoopOptions& options, RunObserver& observer,
-                         const ProgressSink& progress = {}, double progress_interval_seconds = 1.0);
+                         const ProgressSink& progress = {}, double progress_interval_seconds = 1.0,
+                         const Checkpoints& checkpoints = {});
 
 }  // namespace mpmvv

@@ -11,6 +11,7 @@
 
 #include <chrono>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -149,6 +150,7 @@ TEST(SuiteFile, MistakesNameFileLineAndKey) {
            "/ring.toml\"\nsweep = { cells = [32] }\n",
        "characters long, more than the 244 a file name leaves it"},
       {"[[study]\n", "TOML syntax error"},
+      {"checkpoint_every = -5\n" + study, "s.toml:1: 'checkpoint_every' must be a positive number of seconds"},
   };
   for (const Case& c : cases) {
     const std::string message = config_error(write(dir / "s.toml", c.text));
@@ -219,6 +221,53 @@ TEST(SuiteRunner, ResumeRunsOnlyWhatIsMissing) {
   write(suite, small_suite() + "[[study.override]]\nwhere = { cells = 8 }\nset = { cfl = 0.25 }\n");
   ASSERT_EQ(shell(run), 0);
   EXPECT_EQ(count(read(dir / "out" / "manifest.json"), "kept from an earlier run"), 2);
+}
+
+// With checkpoint_every, a case the suite stops (an interrupted suite sends it
+// SIGTERM) saves its state, and the rerun goes on from it: the case ends with
+// the bits of the same run made in one piece, and records where it went on
+// from.
+TEST(SuiteRunner, ACaseStoppedPartWayGoesOnFromItsSavedState) {
+  const fs::path dir = scratch("checkpoints");
+  const std::string set = "{ cells = 256, amplitude = 0.5, end_time = 0.6, output_times = [0.3, 0.6] }";
+  const fs::path suite = write(dir / "s.toml", "checkpoint_every = 0.5\n[[study]]\nname = \"ring\"\nscene = \"" +
+                                                   kScenes + "/ring.toml\"\nset = " + set + "\n");
+  const fs::path out = dir / "out";
+  const fs::path results = out / "cases/ring.h5";
+  const std::string state = results.string() + ".restart";
+  const std::string run = std::string(MPMVV_BINARY) + " suite " + suite.string() + " -j 1 -t 1 -q -o " + out.string();
+  // Stopped once its state has been saved (or after 60 s).
+  const int status = shell("sh -c '" + run + " & suite=$!; for i in $(seq 600); do [ -e " + state +
+                           " ] && break; sleep 0.1; done; kill -INT $suite; wait $suite'");
+  EXPECT_EQ(status, 130);
+  ASSERT_TRUE(fs::exists(state)) << "no state saved";
+  double stopped_at = 0.0;
+  {
+    const mpmvv::h5::File f = mpmvv::h5::File::open_read(results.string());
+    EXPECT_EQ(f.root().attribute_string("status"), "interrupted");
+    stopped_at = f.root().attribute_double("time_reached");
+  }
+  ASSERT_EQ(shell(run), 0);
+  EXPECT_FALSE(fs::exists(state));
+  const fs::path whole = dir / "whole.h5";
+  ASSERT_EQ(shell(std::string(MPMVV_BINARY) + " run " + kScenes + "/ring.toml -q -t 1 --set cells=256 --set " +
+                  "amplitude=0.5 --set end_time=0.6 --set output_times=[0.3,0.6] -o " + whole.string()),
+            0);
+  const mpmvv::h5::File a = mpmvv::h5::File::open_read(results.string());
+  const mpmvv::h5::File b = mpmvv::h5::File::open_read(whole.string());
+  const std::vector<double> resumed_at = a.root().attribute_doubles("resumed_at");
+  ASSERT_EQ(resumed_at.size(), 1u);
+  EXPECT_GT(resumed_at[0], 0.0);
+  EXPECT_LE(resumed_at[0], stopped_at);
+  EXPECT_EQ(a.root().attribute_int("steps"), b.root().attribute_int("steps"));
+  for (const char* name : {"position", "velocity", "deformation_gradient"}) {
+    const std::vector<double> x = a.root().open_group("particles").read_doubles(name);
+    const std::vector<double> y = b.root().open_group("particles").read_doubles(name);
+    ASSERT_EQ(x.size(), y.size()) << name;
+    EXPECT_EQ(std::memcmp(x.data(), y.data(), x.size() * sizeof(double)), 0) << name;
+  }
+  EXPECT_EQ(a.root().open_group("errors").read_doubles("L1_theta0"),
+            b.root().open_group("errors").read_doubles("L1_theta0"));
 }
 
 // A rerun does not keep a results file made with a deliberate fault when none

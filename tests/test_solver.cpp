@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <memory>
 #include <numbers>
@@ -18,6 +19,7 @@
 #include <vector>
 
 #include "solver/explicit_stepper.hpp"
+#include "solver/io/state_archive.hpp"
 #include "solver/parallel.hpp"
 #include "solver/domain_angle.hpp"
 #include "solver/domain_corners.hpp"
@@ -1335,6 +1337,99 @@ TEST(TimeLoop, AStageThatGivesUpEndsTheRunAsFailed) {
   EXPECT_EQ(o.failure_step, 2);
   EXPECT_GT(o.time_reached, 0.0);
   EXPECT_EQ(o.failure_time, o.time_reached);
+}
+
+// Stops the run as a signal would (stop_request), after a given step.
+class StopAfter final : public mpmvv::RunObserver {
+ public:
+  explicit StopAfter(int steps) : steps_(steps) {}
+  void after_step(double, const Stepper&) override {
+    if (++seen_ == steps_) mpmvv::stop_request().store(true);
+  }
+
+ private:
+  int steps_, seen_ = 0;
+};
+
+// A run stopped between two steps saves its state once (Checkpoints), and a
+// stepper built afresh that reads it goes on to the bits of a run that never
+// stopped: every particle array, the step count and the time steps. CPDI with
+// its domains split when they grow long (the particle count grows), under the
+// stable time-step rule (the loop's own measurements are state too).
+TEST(TimeLoop, ARunStoppedBySignalSavesItsStateAndGoesOnFromIt) {
+  SolverOptions options{Method::cpdi, Scheme::usl};
+  options.split_domains_beyond = 0.6;
+  auto make = [&] {
+    Model model = disk_model(Method::cpdi, 16);
+    for (std::size_t p = 0; p < model.particles.size(); ++p) {
+      const Vec2 x = model.particles.position[p];
+      model.particles.velocity[p] = Vec2(-3.0 * x.y(), 3.0 * x.x());
+    }
+    return mpmvv::make_stepper(std::move(model), options, MaterialModel{kSolid}, nullptr);
+  };
+  mpmvv::TimeLoopOptions loop = short_run(0.3);
+  loop.output_times = {0.1, 0.2, 0.3};
+  loop.step_rule = mpmvv::TimeStepRule::stable;
+  loop.track_every = 4;
+
+  auto whole = make();
+  NullObserver none;
+  const mpmvv::RunOutcome reference = mpmvv::run_time_loop(*whole, loop, none);
+  ASSERT_TRUE(reference.completed) << reference.failure_reason;
+  ASSERT_GT(whole->model().particles.size(), make()->model().particles.size()) << "no domain was split";
+  ASSERT_GE(reference.steps, 6);
+  const int stop_after = int(reference.steps / 2);
+
+  const std::string path = (std::filesystem::temp_directory_path() / "mpmvv-loop-state.h5").string();
+  int saves = 0;
+  mpmvv::LoopState saved;
+  mpmvv::Checkpoints checkpoints;
+  auto first = make();
+  checkpoints.save = [&](const mpmvv::LoopState& state) {
+    ++saves;
+    saved = state;
+    mpmvv::h5::File file = mpmvv::h5::File::create(path);
+    {
+      mpmvv::StateArchive a = mpmvv::StateArchive::writing(file.root());
+      first->persist(a);
+    }
+    file.save();
+  };
+  StopAfter stop(stop_after);
+  const mpmvv::RunOutcome stopped = mpmvv::run_time_loop(*first, loop, stop, {}, 1.0, checkpoints);
+  mpmvv::stop_request().store(false);
+  EXPECT_EQ(stopped.failure_reason, mpmvv::kInterrupted);
+  EXPECT_EQ(saves, 1);
+  EXPECT_EQ(saved.steps, stop_after);
+  EXPECT_EQ(saved.t, stopped.time_reached);
+
+  auto second = make();
+  {
+    const mpmvv::h5::File file = mpmvv::h5::File::open_read(path);
+    mpmvv::StateArchive a = mpmvv::StateArchive::reading(file.root());
+    second->persist(a);
+  }
+  mpmvv::Checkpoints going_on;
+  going_on.resume = &saved;
+  const mpmvv::RunOutcome resumed = mpmvv::run_time_loop(*second, loop, none, {}, 1.0, going_on);
+  ASSERT_TRUE(resumed.completed) << resumed.failure_reason;
+  EXPECT_EQ(resumed.steps, reference.steps);
+  EXPECT_EQ(resumed.particle_steps, reference.particle_steps);
+  EXPECT_EQ(resumed.dt_min, reference.dt_min);
+  EXPECT_EQ(resumed.dt_max, reference.dt_max);
+  EXPECT_EQ(resumed.frequency_measurements, reference.frequency_measurements);
+  EXPECT_EQ(resumed.resumed_at, std::vector<double>{saved.t});
+  const Particles& a = whole->model().particles;
+  const Particles& b = second->model().particles;
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t p = 0; p < a.size(); ++p) {
+    EXPECT_EQ(a.position[p], b.position[p]) << p;
+    EXPECT_EQ(a.velocity[p], b.velocity[p]) << p;
+    EXPECT_EQ(a.deformation_gradient[p], b.deformation_gradient[p]) << p;
+    EXPECT_EQ(a.stress[p], b.stress[p]) << p;
+    EXPECT_EQ(a.half_size[p], b.half_size[p]) << p;
+  }
+  std::filesystem::remove(path);
 }
 
 // Output times that do not end at the end time are refused before any step.

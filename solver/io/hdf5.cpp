@@ -169,7 +169,8 @@ void Group::set_attribute(const std::string& name, const std::string& value) {
 void Group::set_attribute(const std::string& name, const std::vector<double>& values) {
   const std::string what = path_ + "@" + name;
   Handle space = simple_space({hsize_t(values.size())}, what);
-  write_attribute(id(), name, H5T_NATIVE_DOUBLE, space.get(), values.data(), what);
+  const double none = 0.0;  // HDF5 takes a buffer even for no elements
+  write_attribute(id(), name, H5T_NATIVE_DOUBLE, space.get(), values.empty() ? &none : values.data(), what);
 }
 
 void Group::write(const std::string& name, const std::vector<double>& data, const std::vector<hsize_t>& dims) {
@@ -179,6 +180,12 @@ void Group::write(const std::string& name, const std::vector<double>& data, cons
 void Group::write(const std::string& name, const std::vector<std::int64_t>& data,
                   const std::vector<hsize_t>& dims) {
   write_dataset(id(), name, H5T_NATIVE_INT64, dims, data.data(), join(path_, name));
+}
+
+void Group::write_bytes(const std::string& name, const void* data, std::size_t size) {
+  // HDF5 takes a buffer even for no elements.
+  const unsigned char none = 0;
+  write_dataset(id(), name, H5T_NATIVE_UCHAR, {hsize_t(size)}, size ? data : &none, join(path_, name));
 }
 
 void Group::write_rows(const std::string& name, const std::vector<hsize_t>& dims, const RowFiller& fill) {
@@ -257,6 +264,33 @@ std::vector<double> Group::read_doubles(const std::string& name, std::vector<hsi
     check_status(H5Dread(set.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()), "H5Dread", what);
   if (dims) *dims = d;
   return data;
+}
+
+bool Group::is_group(const std::string& name) const {
+  const std::string what = join(path_, name);
+  Handle object(check(H5Oopen(id(), name.c_str(), H5P_DEFAULT), "H5Oopen", what), H5Oclose);
+  const H5I_type_t type = H5Iget_type(object.get());
+  if (type == H5I_BADID) fail("H5Iget_type", what);
+  return type == H5I_GROUP;
+}
+
+std::size_t Group::byte_count(const std::string& name) const {
+  const std::string what = join(path_, name);
+  Handle set(check(H5Dopen2(id(), name.c_str(), H5P_DEFAULT), "H5Dopen2", what), H5Dclose);
+  Handle space(check(H5Dget_space(set.get()), "H5Dget_space", what), H5Sclose);
+  const hssize_t count = H5Sget_simple_extent_npoints(space.get());
+  if (count < 0) fail("H5Sget_simple_extent_npoints", what);
+  return std::size_t(count);
+}
+
+void Group::read_bytes(const std::string& name, void* out, std::size_t size) const {
+  const std::string what = join(path_, name);
+  if (const std::size_t stored = byte_count(name); stored != size)
+    throw std::runtime_error("HDF5 dataset " + what + " holds " + std::to_string(stored) + " bytes, not " +
+                             std::to_string(size));
+  Handle set(check(H5Dopen2(id(), name.c_str(), H5P_DEFAULT), "H5Dopen2", what), H5Dclose);
+  if (size > 0)
+    check_status(H5Dread(set.get(), H5T_NATIVE_UCHAR, H5S_ALL, H5S_ALL, H5P_DEFAULT, out), "H5Dread", what);
 }
 
 // The core driver's buffer, allocated through the file image callbacks

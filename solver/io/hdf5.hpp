@@ -46,6 +46,8 @@ class Group {
   Group create_group(const std::string& name);
   Group open_group(const std::string& name) const;
   bool has(const std::string& name) const;
+  // Whether the member `name` is a group (else a dataset).
+  bool is_group(const std::string& name) const;
   bool has_attribute(const std::string& name) const;
   // Names of the group's members, in the order they were written.
   std::vector<std::string> members() const;
@@ -65,12 +67,19 @@ class Group {
   // other dims doubles).
   using RowFiller = std::function<void(std::size_t first, std::size_t count, double* out)>;
   void write_rows(const std::string& name, const std::vector<hsize_t>& dims, const RowFiller& fill);
+  // A one-dimensional dataset of `size` bytes, for what only the build that
+  // wrote it reads back (a restart file: io/state_archive.hpp).
+  void write_bytes(const std::string& name, const void* data, std::size_t size);
 
   double attribute_double(const std::string& name) const;
   std::vector<double> attribute_doubles(const std::string& name) const;
   std::int64_t attribute_int(const std::string& name) const;
   std::string attribute_string(const std::string& name) const;
   std::vector<double> read_doubles(const std::string& name, std::vector<hsize_t>* dims = nullptr) const;
+  // The length of a dataset of bytes, and its bytes into `out` (`size` of
+  // them, which must be its length).
+  std::size_t byte_count(const std::string& name) const;
+  void read_bytes(const std::string& name, void* out, std::size_t size) const;
 
  private:
   Handle handle_;

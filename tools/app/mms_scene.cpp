@@ -1,6 +1,7 @@
 #include "mms_scene.hpp"
 
 #include "fault.hpp"
+#include "solver/io/state_archive.hpp"
 #include "solver/parallel.hpp"
 #ifdef MPMVV_HAVE_SUNDIALS
 #include "solver/implicit/static_stepper.hpp"
@@ -9,7 +10,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <functional>
 #include <limits>
 #include <numbers>
@@ -22,6 +25,8 @@
 #endif
 
 namespace mpmvv::app {
+
+namespace fs = std::filesystem;
 
 const char* to_string(ProbeQuantity q) {
   switch (q) {
@@ -144,6 +149,12 @@ double probe_value(ProbeQuantity q, Geometry geometry, const Vec2& x, const Vec2
 
 struct LineRecord {
   std::vector<std::vector<double>> simulated, exact;  // per output time
+
+  template <class Archive>
+  void persist(Archive& a) {
+    a.field("simulated", simulated);
+    a.field("exact", exact);
+  }
 };
 
 class MmsCase final : public SceneCase, private RunObserver {
@@ -203,7 +214,7 @@ class MmsCase final : public SceneCase, private RunObserver {
           particles, nodes, machine / 1073741824.0));
   }
 
-  RunOutcome run(const ProgressSink& progress) override {
+  RunOutcome run(const ProgressSink& progress, const RestartPlan& restart) override {
     refuse_what_cannot_fit();
     Model model;
     model.grid = setup_.grid;
@@ -236,8 +247,99 @@ class MmsCase final : public SceneCase, private RunObserver {
     } else {
       stepper_ = make_stepper(std::move(model), options_, setup_.material, std::move(stages));
     }
-    outcome_ = run_time_loop(*stepper_, loop_, *this, progress);
+    Checkpoints checkpoints;
+    LoopState resumed;
+    if (!restart.path.empty()) {
+      if (!stepper_->restartable())
+        throw ConfigError("a restart file (--checkpoint-every, --pause-at, --resume) holds the state of explicit "
+                          "runs only: solver = \"implicit\" keeps its own");
+      if (restart.resume) {
+        read_state(restart.path, resumed);
+        checkpoints.resume = &resumed;
+      }
+      checkpoints.every_seconds = restart.every_seconds;
+      checkpoints.pause_at = restart.pause_at;
+      checkpoints.save = [this, &restart](const LoopState& state) { save_state(restart, state); };
+    }
+    outcome_ = run_time_loop(*stepper_, loop_, *this, progress, 1.0, checkpoints);
     return outcome_;
+  }
+
+  // The run's state between two steps, and what the case has recorded so far
+  // (persist): written to a partial file and renamed, so that a run killed
+  // while it saves keeps the state it saved before.
+  void save_state(const RestartPlan& restart, const LoopState& state) {
+    const std::string partial = restart.path + ".partial";
+    const auto start = std::chrono::steady_clock::now();
+    try {
+      h5::File file = h5::File::create(partial);
+      {
+        h5::Group root = file.root();
+        for (const auto& [name, value] : restart.identity) root.set_attribute(name, value);
+        root.set_attribute("time", state.t);
+        root.set_attribute("steps", std::int64_t(state.steps));
+        StateArchive a = StateArchive::writing(root.create_group("state"));
+        LoopState loop = state;
+        a.field("loop", loop);
+        a.field("stepper", *stepper_);
+        a.field("scene", *this);
+      }
+      file.save();
+      fs::rename(partial, restart.path);
+      if (restart.tell)
+        restart.tell(fmt::format("state at t = {:.6g} s (step {}) saved to {}: {:.3g} MB in {:.3g} s", state.t,
+                                 state.steps, restart.path, double(fs::file_size(restart.path)) / 1e6,
+                                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()),
+                     false);
+    } catch (const std::exception& e) {
+      std::error_code ec;
+      fs::remove(partial, ec);
+      if (restart.tell) restart.tell(fmt::format("saving the state to {} failed: {}", restart.path, e.what()), true);
+    }
+  }
+
+  void read_state(const std::string& path, LoopState& loop) {
+    try {
+      const h5::File file = h5::File::open_read(path);
+      StateArchive a = StateArchive::reading(file.root().open_group("state"));
+      a.field("loop", loop);
+      a.field("stepper", *stepper_);
+      a.field("scene", *this);
+    } catch (const std::exception& e) {
+      throw ConfigError(fmt::format("the restart file {} cannot be read ({}): remove it to start again", path,
+                                    e.what()));
+    }
+  }
+
+  // What the observer has recorded (the rest is rebuilt as the case is set
+  // up: seeding, tracers, probes).
+  void persist(StateArchive& a) {
+    a.field("line_records", line_records_);
+    a.field("point_time", point_time_);
+    a.field("point_simulated", point_simulated_);
+    a.field("point_exact", point_exact_);
+    a.field("circle_simulated", circle_simulated_);
+    a.field("circle_exact", circle_exact_);
+    a.field("circle_spectrum", circle_spectrum_);
+    a.field("output_times", output_times_);
+    a.field("history_time", history_time_);
+    a.field("history_values", history_values_);
+    a.field("monitor_rows", monitor_rows_);
+    a.field("j_ratio", j_ratio_);
+    a.field("sampled_motion", sampled_motion_);
+    a.field("initial_energy", initial_energy_);
+    a.field("largest_energy", largest_energy_);
+    a.field("rule_step", rule_step_);
+    a.field("stop", stop_);
+    a.field("errors", errors_);
+    a.field("integrated", integrated_);
+    bool settling = settling_.has_value();
+    a.field("settling", settling);
+    if (a.reads()) {
+      settling_.reset();
+      if (settling) settling_.emplace(*setup_.settling, loop_.end_time, !implicit());
+    }
+    if (settling_) a.field("settling_watch", *settling_);
   }
 
   bool implicit() const { return config_.has("solver") && config_.text("solver") == "implicit"; }

@@ -149,6 +149,9 @@ void write_run(h5::Group root, const RunRequest& request, const Config& config, 
   root.set_attribute("dt_min", o.dt_min);
   root.set_attribute("dt_max", o.dt_max);
   root.set_attribute("frequency_measurements", static_cast<double>(o.frequency_measurements));
+  // A run continued from restart files: the times it went on from (none for
+  // a run in one piece); its wall time is that of the parts that made it.
+  root.set_attribute("resumed_at", o.resumed_at);
   scene.write_results(root);
   write_errors(root, scene.errors(), scene.error_description());
   if (const auto m = scene.measurements(); !m.empty()) {
@@ -162,6 +165,66 @@ void write_results_file(const std::string& path, const RunRequest& request, cons
   h5::File file = h5::File::create(path);
   write_run(file.root(), request, config, scene, o, health, fault);  // the root group closes on return
   file.save();
+}
+
+// The first line where two texts differ, for a message.
+std::string first_difference(const std::string& a, const std::string& b) {
+  std::istringstream x(a), y(b);
+  std::string p, q;
+  while (true) {
+    const bool more_x = bool(std::getline(x, p)), more_y = bool(std::getline(y, q));
+    if (!more_x && !more_y) return "";
+    if (!more_x) p = "(nothing)";
+    if (!more_y) q = "(nothing)";
+    if (p != q || !more_x || !more_y) return fmt::format("'{}' there, '{}' here", p, q);
+  }
+}
+
+// The restart file the request asks for, and whether the run goes on from
+// it: only from the state of the same run (configuration, build, threads,
+// fault), since no other would continue with the same bits.
+RestartPlan restart_plan(const RunRequest& request, const std::string& output, const Config& config, Fault fault,
+                         std::ostream& err) {
+  RestartPlan plan;
+  using Resume = RunRequest::Resume;
+  if (!(request.checkpoint_every > 0.0 || request.pause_at >= 0.0 || request.resume != Resume::no)) return plan;
+  plan.path = restart_path(output);
+  plan.every_seconds = request.checkpoint_every;
+  if (request.pause_at >= 0.0) plan.pause_at = request.pause_at;
+  plan.identity = {{"configuration", config.to_toml()},
+                   {"version", version_string()},
+                   {"threads", std::to_string(max_threads())},
+                   {"fault", to_string(fault)}};
+  // Each save is told, even with --quiet (a suite's case log shows them); on a
+  // terminal the message ends the progress line first.
+  const bool tty = isatty(fileno(stderr));
+  plan.tell = [&err, tty](const std::string& message, bool failed) {
+    fmt::print(err, "{}mpmvv run: {}{}\n", tty ? "\n" : "", failed ? "warning: " : "", message);
+  };
+  std::error_code ec;
+  if (request.resume == Resume::no || !fs::exists(plan.path, ec)) return plan;
+  std::string why_not;  // why the file's state is not this run's
+  try {
+    const h5::File file = h5::File::open_read(plan.path);
+    const h5::Group root = file.root();
+    for (const auto& [name, value] : plan.identity)
+      if (const std::string saved = root.attribute_string(name); saved != value && why_not.empty())
+        why_not = fmt::format("it holds the state of a run with another {} ({}), which would not go on with the "
+                              "same bits", name, first_difference(saved, value));
+    if (why_not.empty())
+      fmt::print(err, "mpmvv run: going on from {} (t = {:.6g} s, step {})\n", plan.path,
+                 root.attribute_double("time"), root.attribute_int("steps"));
+  } catch (const std::exception& e) {
+    why_not = fmt::format("it cannot be read ({})", e.what());
+  }
+  if (why_not.empty()) {
+    plan.resume = true;
+  } else if (request.resume == Resume::yes) {
+    throw ConfigError(fmt::format("the restart file {}: {}; remove it to start again", plan.path, why_not));
+  } else {
+    fmt::print(err, "mpmvv run: starting from t = 0: the restart file {}: {}\n", plan.path, why_not);
+  }
+  return plan;
 }
 
 // On a terminal one line rewritten every second; in a log a new line every
@@ -185,6 +248,8 @@ ProgressSink progress_printer(std::ostream& err) {
 }
 
 }  // namespace
+
+std::string restart_path(const std::string& output) { return output + ".restart"; }
 
 std::string describe_configuration(const std::string& scene_file, const std::vector<std::string>& overrides) {
   const Config c = load(scene_file, overrides);
@@ -239,6 +304,13 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
   set_threads(request.threads);
   if (fault == Fault::crash) std::abort();
   while (fault == Fault::hang) std::this_thread::sleep_for(std::chrono::seconds(1));
+  RestartPlan restart;
+  try {
+    restart = restart_plan(request, output, config, fault, err);
+  } catch (const ConfigError& e) {
+    fmt::print(err, "mpmvv run: {}\n", e.what());
+    return 2;
+  }
 
   if (!request.quiet)
     fmt::print(err, "mpmvv run {} -> {} ({} threads)\nconfiguration:{}\n", request.scene_file, output, max_threads(),
@@ -261,7 +333,7 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
   } restore{before_int, before_term};
   RunOutcome o;
   try {
-    o = scene->run(request.quiet ? ProgressSink{} : progress_printer(err));
+    o = scene->run(request.quiet ? ProgressSink{} : progress_printer(err), restart);
   } catch (const ConfigError& e) {
     fmt::print(err, "mpmvv run: {}\n", e.what());
     return 2;
@@ -316,6 +388,14 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
   print_error_table(out, scene->errors());
   print_measurements(out, scene->measurements());
   fmt::print(out, "results: {}\n", output);
+  // The state of a run that has ended is of no more use: its results are whole.
+  if (!restart.path.empty()) {
+    std::error_code ec;
+    if (o.failure_reason != kInterrupted)
+      fs::remove(restart.path, ec);
+    else if (fs::exists(restart.path, ec))
+      fmt::print(out, "its state: {} (go on with the same command and --resume)\n", restart.path);
+  }
   if (o.failure_reason == kInterrupted) return 130;
   return o.completed && !health.lost ? 0 : 1;
 }

@@ -15,8 +15,21 @@ struct RunRequest {
   bool quiet = false;                  // no echo, no progress
   bool describe = false;               // print the resolved configuration and stop
   int threads = 0;                     // 0: the OpenMP default
+  // A restart file, <output>.restart (restart_path): saved every this many
+  // seconds of wall time and when the run stops early; 0: never.
+  double checkpoint_every = 0.0;
+  double pause_at = -1.0;  // when >= 0, stop from this simulated time on, saving the state
+  // Go on from the restart file when there is one: `yes` refuses a file of
+  // another run (configuration, build, threads), `if_same` starts such a run
+  // from t = 0 instead (what a suite asks for, where a file an older build
+  // left must not stop the case).
+  enum class Resume { no, yes, if_same };
+  Resume resume = Resume::no;
   std::string command_line;
 };
+
+// Where a run writing `output` keeps its state for --resume.
+std::string restart_path(const std::string& output);
 
 // Exit status: 0 the run completed; 1 the solver stopped it (results written,
 // status "failed"); 2 bad input (nothing run).

@@ -5,6 +5,7 @@
 
 #include <functional>
 #include <iosfwd>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -27,14 +28,35 @@ struct ErrorTable {
   const std::vector<double>& column(const std::string& name) const;  // throws when there is none
   const std::vector<double>* find(const std::string& name) const;     // null when there is none
   std::vector<double>& add_column(const std::string& name);
+
+  template <class Archive>
+  void persist(Archive& a) {
+    a.field("time", time);
+    a.field("columns", columns);
+  }
+};
+
+// A restart file for SceneCase::run (solver/time_loop.hpp: Checkpoints).
+struct RestartPlan {
+  std::string path;  // where the state is saved and read; empty: no restart file
+  double every_seconds = 0.0;                                   // wall time between saves; 0: only on an early stop
+  double pause_at = std::numeric_limits<double>::infinity();  // stop, saving the state, from this time on
+  bool resume = false;  // go on from the state at `path` (whose identity the caller has checked)
+  // Attributes of the file's root that say which run the state belongs to
+  // (configuration, build, threads), for the caller to check before a resume.
+  std::vector<std::pair<std::string, std::string>> identity;
+  // Told of each save (`failed`: a save that failed, which the run goes on
+  // without).
+  std::function<void(const std::string& message, bool failed)> tell;
 };
 
 // One configured case of a scene, ready to run.
 class SceneCase {
  public:
   virtual ~SceneCase() = default;
-  // Steps the scene to its end time (or to the step that stopped it).
-  virtual RunOutcome run(const ProgressSink& progress) = 0;
+  // Steps the scene to its end time (or to the step that stopped it), saving
+  // and going on from a restart file as `restart` says.
+  virtual RunOutcome run(const ProgressSink& progress, const RestartPlan& restart = {}) = 0;
   // A deliberate fault (tools/app/fault.hpp), set before run().
   virtual void inject(Fault fault) = 0;
   // Cell size, for the results file.

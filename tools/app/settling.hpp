@@ -62,6 +62,15 @@ class SettlingWatch {
   // state observe() kept.
   Settling relaxation(double t, const Particles& P) const;
 
+  // What observe() kept (the rest follows from the constructor's arguments).
+  template <class Archive>
+  void persist(Archive& a) {
+    a.field("kept_at", kept_at_);
+    a.field("norms", norms_);
+    a.field("position", position_);
+    a.field("deformation_gradient", deformation_gradient_);
+  }
+
  private:
   SettlingBody body_;
   bool relaxes_;

@@ -354,7 +354,7 @@ Suite load_suite(const std::string& path) {
     throw ConfigError(fmt::format("{}:{}:{}: TOML syntax error: {}", path, e.source().begin.line,
                                   e.source().begin.column, e.description()));
   }
-  expect_only(top, {"description", "timeout", "study", "expect", "reference"}, path, "the suite");
+  expect_only(top, {"description", "timeout", "checkpoint_every", "study", "expect", "reference"}, path, "the suite");
   Suite suite;
   suite.file = path;
   suite.name = fs::path(path).stem().string();
@@ -362,14 +362,19 @@ Suite load_suite(const std::string& path) {
     if (!d->is_string()) throw ConfigError(fmt::format("{}: 'description' must be a string", where_in(path, *d)));
     suite.description = d->as_string()->get();
   }
-  if (const toml::node* t = top.get("timeout")) {
+  // A key of seconds: a positive number, when given.
+  auto seconds_of = [&](const char* key, double& seconds) {
+    const toml::node* t = top.get(key);
+    if (!t) return;
     const std::optional<Value> v = to_value(*t);
-    const double seconds = v && std::holds_alternative<std::int64_t>(*v) ? double(std::get<std::int64_t>(*v))
-                           : v && std::holds_alternative<double>(*v)     ? std::get<double>(*v)
-                                                                         : -1.0;
-    if (!(seconds > 0.0)) throw ConfigError(fmt::format("{}: 'timeout' must be a positive number of seconds", where_in(path, *t)));
-    suite.timeout_seconds = seconds;
-  }
+    seconds = v && std::holds_alternative<std::int64_t>(*v) ? double(std::get<std::int64_t>(*v))
+              : v && std::holds_alternative<double>(*v)     ? std::get<double>(*v)
+                                                            : -1.0;
+    if (!(seconds > 0.0))
+      throw ConfigError(fmt::format("{}: '{}' must be a positive number of seconds", where_in(path, *t), key));
+  };
+  seconds_of("timeout", suite.timeout_seconds);
+  seconds_of("checkpoint_every", suite.checkpoint_seconds);
   const toml::node* studies = top.get("study");
   if (!studies || !studies->is_array_of_tables() || studies->as_array()->empty())
     throw ConfigError(fmt::format("{}: a suite needs at least one [[study]]", path));
@@ -738,7 +743,7 @@ struct Running {
 // Starts `mpmvv run` for a case in a process group of its own, with its output
 // in the case's log.
 pid_t spawn_case(const std::string& exe, const SuiteCase& c, const fs::path& results, const fs::path& log, int threads,
-                 bool passive_wait) {
+                 bool passive_wait, double checkpoint_seconds) {
   std::vector<std::string> args = {exe, "run", c.scene_file};
   for (const std::string& o : c.overrides) {
     args.push_back("--set");
@@ -747,6 +752,11 @@ pid_t spawn_case(const std::string& exe, const SuiteCase& c, const fs::path& res
   for (const std::string& a : {std::string("-o"), results.string(), std::string("--quiet"), std::string("--threads"),
                                std::to_string(threads)})
     args.push_back(a);
+  // A case the suite stopped goes on from its saved state.
+  if (checkpoint_seconds > 0.0)
+    for (const std::string& a : {std::string("--checkpoint-every"), fmt::format("{}", checkpoint_seconds),
+                                 std::string("--resume-if-same")})
+      args.push_back(a);
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -1034,7 +1044,7 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
       fs::remove(results_of(i), ec);
       try {
         running.push_back({i, spawn_case(exe, suite.cases[i], results_of(i), cases_dir / (suite.cases[i].id + ".log"),
-                                         threads, passive),
+                                         threads, passive, suite.checkpoint_seconds),
                            std::chrono::steady_clock::now()});
         state[i].status = "running";
       } catch (const std::exception& e) {

@@ -27,6 +27,11 @@ struct Suite {
   std::string file;
   std::string description;
   double timeout_seconds = 3600.0;
+  // Wall time between the saves of each case's state (mpmvv run
+  // --checkpoint-every), so that a case longer than a sitting goes on where it
+  // stopped when the suite is run again; 0: no saves, an unfinished case runs
+  // again from t = 0.
+  double checkpoint_seconds = 0.0;
   std::vector<SuiteCase> cases;
   // What the loader found doubtful but not wrong, each with the file and line
   // (an expectation read where the exact signal is trivial).

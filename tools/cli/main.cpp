@@ -43,6 +43,23 @@ int main(int argc, char** argv) {
   run_cmd->add_option("-t,--threads", run.threads, "OpenMP threads (default: all cores)")->check(CLI::Range(0, 1024));
   run_cmd->add_flag("-q,--quiet", run.quiet, "no configuration echo and no progress line");
   run_cmd->add_flag("--describe", run.describe, "print every key of the scene with its value and meaning, then stop");
+  run_cmd->add_option("--checkpoint-every", run.checkpoint_every,
+                      "save the run's state to FILE.restart (FILE the results file) every SECONDS of wall time and "
+                      "when it is stopped early (a signal, --pause-at), for --resume")
+      ->type_name("SECONDS")
+      ->check(CLI::PositiveNumber);
+  run_cmd->add_option("--pause-at", run.pause_at,
+                      "stop before the first step from simulated time T on, as interrupted, saving its state to "
+                      "FILE.restart for --resume")
+      ->type_name("T")
+      ->check(CLI::NonNegativeNumber);
+  bool resume = false, resume_if_same = false;
+  run_cmd->add_flag("--resume", resume,
+                    "go on from FILE.restart when it exists, to the bits of a run that never stopped (refused when it "
+                    "holds another configuration, build or thread count); start from t = 0 when it does not");
+  run_cmd->add_flag("--resume-if-same", resume_if_same,
+                    "as --resume, but start from t = 0 when FILE.restart holds another run's state (what a suite "
+                    "passes)");
 
   app.add_subcommand("scenes", "List the scenes and the keys each accepts.");
 
@@ -167,6 +184,9 @@ int main(int argc, char** argv) {
       }
     }
     run.command_line = joined(argc, argv);
+    run.resume = resume           ? mpmvv::app::RunRequest::Resume::yes
+                 : resume_if_same ? mpmvv::app::RunRequest::Resume::if_same
+                                  : mpmvv::app::RunRequest::Resume::no;
     return mpmvv::app::run_case(run, std::cout, std::cerr);
   }
   return 2;
