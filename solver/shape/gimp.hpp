@@ -189,17 +189,6 @@ struct GimpShapeT {
       }
   }
 
-  // Where lane l's nodes are a 3 x 3 block (scatter_lanes.hpp), its first
-  // node; -1 where the kernel held a node at the grid's edge (its weight 0).
-  std::ptrdiff_t lane_block_first(const LaneBatch& batch, int l) const
-    requires lanes
-  {
-    const GimpLaneStencils& out = batch.out;
-    const int i = out.node_i[0][l], j = out.node_j[0][l];
-    if (out.node_i[2][l] != i + 2 || out.node_j[2][l] != j + 2) return -1;
-    return grid->node(i, j);
-  }
-
   // No bounds of sum_g |G_gp|: uGIMP's gradients are the grid basis's.
   const double* lane_gradient_bounds(const LaneBatch&) const
     requires lanes
