@@ -406,7 +406,7 @@ class ExplicitStepper final : public Stepper {
     remember_volumes();
     {
       const StageClock clock(stage_times_.update);
-      deforming([&] { grid_to_particles<kDeformation, Shape>(shape, fields_, P, dt, kick); });
+      deforming([&] { grid_to_particles<kDeformation, Shape>(shape, fields_, P, dt, kick, nullptr, {}, &node_motion_); });
     }
     update_stress_of_particles(dt);
     if (body_force_) evaluate_body_force(t);
@@ -442,7 +442,7 @@ class ExplicitStepper final : public Stepper {
     remember_volumes();
     {
       const StageClock clock(stage_times_.update);
-      deforming([&] { grid_to_particles<kDeformation, Shape>(shape, fields_, P, dt, kick); });
+      deforming([&] { grid_to_particles<kDeformation, Shape>(shape, fields_, P, dt, kick, nullptr, {}, &node_motion_); });
     }
     P.position.swap(next_position_);
     if constexpr (kCornerDomains) P.domain_corner.swap(next_corner_);
@@ -525,9 +525,10 @@ class ExplicitStepper final : public Stepper {
     const StageClock clock(stage_times_.update);
     deforming<(Updates & kDeformation) != 0>([&] {
       if (apic_ || fault_ == SolverFault::pic_velocity)
-        grid_to_particles<Updates | kAffine, S>(shape, g, model_.particles, dt, kick, position_out, range);
+        grid_to_particles<Updates | kAffine, S>(shape, g, model_.particles, dt, kick, position_out, range,
+                                                &node_motion_);
       else
-        grid_to_particles<Updates, S>(shape, g, model_.particles, dt, kick, position_out, range);
+        grid_to_particles<Updates, S>(shape, g, model_.particles, dt, kick, position_out, range, &node_motion_);
     });
   }
 
@@ -704,6 +705,7 @@ class ExplicitStepper final : public Stepper {
   std::vector<Vec2> gradient_a_, gradient_b_;  // mass gradients, eq. 1.107
   std::vector<std::vector<Vec2>> gradient_buffers_;
   ScatterBuffers buffers_;
+  std::vector<double> node_motion_;  // grid_to_particles' packed a_g and v_g^L
   std::vector<Vec2> next_position_;  // MUSL only: x_{n+1} while x_n still sets the weights
   std::vector<std::size_t> split_parents_;  // split_long_domains: the particles a split cut in the last step
   std::vector<Vec2> next_corner_;    // MUSL with corner domains: the corners at t_{n+1}, likewise

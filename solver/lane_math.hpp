@@ -32,17 +32,7 @@ void lane_log(std::size_t n, const double* x, double* log_x);
 void lane_log(LaneBuild build, std::size_t n, const double* x, double* log_x);
 
 // Each build's own, compiled for its instructions (solver/CMakeLists.txt).
-namespace lanes::avx512 {
-void sincos_array(std::size_t n, const double* x, double* sin_x, double* cos_x);
-void log_array(std::size_t n, const double* x, double* log_x);
-}
-namespace lanes::avx2 {
-void sincos_array(std::size_t n, const double* x, double* sin_x, double* cos_x);
-void log_array(std::size_t n, const double* x, double* log_x);
-}
-namespace lanes::baseline {
-void sincos_array(std::size_t n, const double* x, double* sin_x, double* cos_x);
-void log_array(std::size_t n, const double* x, double* log_x);
-}
+MPMVV_LANE_KERNEL(void sincos_array(std::size_t n, const double* x, double* sin_x, double* cos_x))
+MPMVV_LANE_KERNEL(void log_array(std::size_t n, const double* x, double* log_x))
 
 }  // namespace mpmvv

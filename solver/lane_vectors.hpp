@@ -39,6 +39,16 @@
 #define MPMVV_LANE_BUILD_CALL(build, call) lanes::baseline::call
 #endif
 
+// The two dispatching functions of a kernel whose call has nothing around it:
+// name(build, params) runs the given build, name(params) the one the kernels
+// run (lane_build). `params` and `args` in parentheses.
+#define MPMVV_LANE_EXPAND(...) __VA_ARGS__
+#define MPMVV_LANE_DISPATCH_OF(name, params, args)                                   \
+  void name(::mpmvv::LaneBuild build, MPMVV_LANE_EXPAND params) {                    \
+    MPMVV_LANE_BUILD_CALL(build, name args);                                         \
+  }                                                                                  \
+  void name(MPMVV_LANE_EXPAND params) { name(::mpmvv::lane_build(), MPMVV_LANE_EXPAND args); }
+
 // Inlined into the build's loop, so that no vector crosses a call (the
 // warning is about how one would be passed if it did).
 #define MPMVV_LANE_INLINE inline __attribute__((always_inline))

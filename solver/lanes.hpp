@@ -35,3 +35,17 @@ LaneBuild lane_build();
 const char* name(LaneBuild build);
 
 }  // namespace mpmvv
+
+// Declares a kernel function, inside namespace mpmvv, once in each build's
+// namespace (solver/CMakeLists.txt compiles each kernel file once a build);
+// the dispatch (lane_vectors.hpp: MPMVV_LANE_BUILD_CALL) picks one.
+#define MPMVV_LANE_KERNEL(...)     \
+  namespace lanes::avx512 {        \
+  __VA_ARGS__;                     \
+  }                                \
+  namespace lanes::avx2 {          \
+  __VA_ARGS__;                     \
+  }                                \
+  namespace lanes::baseline {      \
+  __VA_ARGS__;                     \
+  }

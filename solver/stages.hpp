@@ -17,6 +17,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "gather_lanes.hpp"
 #include "geometry.hpp"
 #include "grid.hpp"
 #include "material/neo_hookean.hpp"
@@ -24,6 +25,7 @@
 #include "material/stress.hpp"
 #include "parallel.hpp"
 #include "particles.hpp"
+#include "scatter_lanes.hpp"
 #include "shape/cpdi_lanes.hpp"
 #include "shape/linear.hpp"
 #include "shape/stencil.hpp"
@@ -45,23 +47,85 @@ enum TransferField : unsigned {
                           // total momentum is still sum_p m_p v_p
 };
 
+// A node's five sums side by side.
 struct NodeSums {
   double mass, momentum_x, momentum_y, force_x, force_y;
 };
 
-// One scatter buffer per thread, each covering the whole grid.
+// One scatter buffer per thread, each covering the whole grid with a node's
+// five sums (mass, momentum x and y, force x and y). Each thread sizes its own
+// when it first maps, in the layout of the stage (ScatterSums).
 struct ScatterBuffers {
-  std::vector<std::vector<NodeSums>> per_thread;
+  static constexpr int kFields = 5;
+  std::vector<std::vector<NodeSums>> by_node;  // ScatterSums<false>
+  std::vector<std::vector<double>> by_field;   // ScatterSums<true>
 
-  void resize(int threads, std::size_t nodes) {
-    per_thread.assign(std::size_t(threads), std::vector<NodeSums>(nodes));
+  void resize(int threads, std::size_t /*nodes: each thread sizes its own*/) {
+    by_node.assign(std::size_t(threads), {});
+    by_field.assign(std::size_t(threads), {});
   }
+  int threads() const { return int(by_node.size()); }
+};
+
+// Where node i's sum k (NodeSums' order) lies in a thread's buffer. Node by
+// node (ScatterBuffers::by_node: the five sums of a node side by side, one
+// cache line) for a stage that adds one entry at a time; field by field
+// (by_field: five arrays `stride` apart, with room past the last node for the
+// row of a block at the grid's edge) for a stage that adds 3 x 3 blocks by
+// rows (scatter_lanes.hpp), where a block's row of nodes lies side by side in
+// each array. Measured (callgrind, CPDI at A = 1, t = 0.40-0.44 s, where most
+// domains stretch past a cell and go entry by entry): with its sums field by
+// field that stage cost 2,262-2,303 instructions a particle-step (restricted
+// pointers or a type of its own for each field changed nothing) against 2,128
+// with NodeSums, whose five sums one address reaches. So CPDI keeps NodeSums
+// and adds entry by entry, and only uGIMP, whose stencils are blocks, adds by
+// rows (scatters_by_rows).
+template <bool ByField>
+struct ScatterSums;
+
+template <>
+struct ScatterSums<false> {
+  NodeSums* node;
+
+  static std::vector<NodeSums>& own(ScatterBuffers& b, int thread) { return b.by_node[std::size_t(thread)]; }
+  static std::size_t size_of(std::size_t nodes, std::ptrdiff_t) { return nodes; }
+  explicit ScatterSums(std::vector<NodeSums>& v, std::size_t) : node(v.data()) {}
+  double& operator()(int k, std::size_t i) const {
+    NodeSums& n = node[i];
+    return k == 0 ? n.mass : k == 1 ? n.momentum_x : k == 2 ? n.momentum_y : k == 3 ? n.force_x : n.force_y;
+  }
+};
+
+template <>
+struct ScatterSums<true> {
+  double* data;
+  std::size_t stride;  // the nodes, a row and 4
+
+  static std::vector<double>& own(ScatterBuffers& b, int thread) { return b.by_field[std::size_t(thread)]; }
+  static std::size_t stride_of(std::size_t nodes, std::ptrdiff_t row) { return nodes + std::size_t(row) + 4; }
+  static std::size_t size_of(std::size_t nodes, std::ptrdiff_t row) {
+    return ScatterBuffers::kFields * stride_of(nodes, row);
+  }
+  explicit ScatterSums(std::vector<double>& v, std::size_t nodes_stride) : data(v.data()), stride(nodes_stride) {}
+  double& operator()(int k, std::size_t i) const { return data[std::size_t(k) * stride + i]; }
 };
 
 // True for a shape that evaluates its stencils by lanes (cpdi_lanes.hpp).
 template <class Shape>
 constexpr bool evaluates_lanes() {
   if constexpr (requires { Shape::lanes; }) return Shape::lanes;
+  return false;
+}
+
+// True for a shape whose lane kernel leaves every stencil as a 3 x 3 block of
+// nodes but at the grid's edge (uGIMP: a domain of at most a cell's width),
+// so that particle-to-grid adds its batches by rows (scatter_lanes.hpp).
+// CPDI's domains stretch past a cell (most of them from t = 0.3 s of the
+// ring at A = 1), and a stage that goes by rows only in part costs CPDI more
+// than it saves (ScatterSums): CPDI adds entry by entry.
+template <class Shape>
+constexpr bool scatters_by_rows() {
+  if constexpr (requires { Shape::lane_blocks_only; }) return evaluates_lanes<Shape>() && Shape::lane_blocks_only;
   return false;
 }
 
@@ -101,16 +165,44 @@ struct LaneBatchOf<Shape> {
 // scan, where its bounds do not settle a speed). usable(p, inside) is asked
 // first, with the shape's test of the particle's domain in the grid (from
 // the lanes' own values where `for_scan`, as are the bounds); a particle it
-// refuses is skipped. `on_lanes(first, count, gradient_bounds)`, where
-// given, sees each batch of kLanes particles before they are visited, with
-// the kernel's bounds of the batch (lane_gradient_bounds; null without lanes
-// or bounds): the particles go in batches then for any shape. Ends with the
-// threads' barrier.
+// refuses is skipped. `on_lanes(first, count, gradient_bounds, batch)`,
+// where given, sees each batch of kLanes particles before they are visited,
+// with the kernel's bounds of the batch (lane_gradient_bounds; null without
+// lanes or bounds) and the kernel's batch itself (an empty one without
+// lanes): the particles go in batches then for any shape. A hook that
+// returns true has dealt with the whole batch, whose particles are then not
+// visited (the transfers by rows: scatter_lanes.hpp, gather_lanes.hpp).
+// `after_lanes()`, where given, is called after each batch's visits. Ends
+// with the threads' barrier.
 struct NoLaneHook {};
 
-template <class Shape, class Usable, class Visit, class OnLanes = NoLaneHook>
+// Lane l's entries in a batch (for_each_stencil): entries(f) as for any
+// stencil, and the batch and lane themselves, for a stage that takes a
+// block of nodes at once (particles_to_grid, scatter_lanes.hpp).
+// The slots a lane kernel left in its batch (S_gp and G_gp by slot and lane:
+// CPDI's and uGIMP's alike), for a transfer by rows.
+template <class Batch, class Rows>
+void take_slots(const Batch& batch, Rows& rows) {
+  rows.weight = batch.out.weight;
+  rows.gradient_x = batch.out.gradient_x;
+  rows.gradient_y = batch.out.gradient_y;
+}
+
+template <class Shape>
+struct LaneEntries {
+  const Shape& shape;
+  const typename Shape::LaneBatch& batch;
+  int lane;
+  int count;  // the batch's particles
+  template <class F>
+  void operator()(F&& f) const {
+    shape.for_each_lane_entry(batch, lane, f);
+  }
+};
+
+template <class Shape, class Usable, class Visit, class OnLanes = NoLaneHook, class AfterLanes = NoLaneHook>
 void for_each_stencil(const Shape& shape, std::size_t begin, std::size_t end, bool for_scan, Usable usable,
-                      Visit visit, OnLanes on_lanes = {}) {
+                      Visit visit, OnLanes on_lanes = {}, AfterLanes after_lanes = {}) {
   constexpr bool lanes = evaluates_lanes<Shape>();
   constexpr bool hooked = !std::is_same_v<OnLanes, NoLaneHook>;
   Stencil<Shape::stencil_size> s;
@@ -134,7 +226,14 @@ void for_each_stencil(const Shape& shape, std::size_t begin, std::size_t end, bo
         shape.compute_lanes(p0, count, batch, for_scan);
         bounds = shape.lane_gradient_bounds(batch);
       }
-      if constexpr (hooked) on_lanes(p0, count, bounds);
+      if constexpr (hooked) {
+        // A hook that returns true has taken the whole batch itself.
+        if constexpr (std::is_same_v<decltype(on_lanes(p0, count, bounds, batch)), bool>) {
+          if (on_lanes(p0, count, bounds, batch)) continue;
+        } else {
+          on_lanes(p0, count, bounds, batch);
+        }
+      }
       for (int l = 0; l < count; ++l) {
         const std::size_t p = p0 + std::size_t(l);
         if constexpr (lanes) {
@@ -145,11 +244,12 @@ void for_each_stencil(const Shape& shape, std::size_t begin, std::size_t end, bo
             listed = true;
             return s;
           };
-          visit(p, [&](auto&& f) { shape.for_each_lane_entry(batch, l, f); }, stencil_of, bounds ? bounds[l] : -1.0);
+          visit(p, LaneEntries<Shape>{shape, batch, l, count}, stencil_of, bounds ? bounds[l] : -1.0);
         } else {
           one(p);
         }
       }
+      if constexpr (!std::is_same_v<AfterLanes, NoLaneHook>) after_lanes();
     }
 #pragma omp barrier
   }
@@ -191,14 +291,38 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
   constexpr bool with_body = Fields & kBodyForce;
   constexpr bool with_force = with_internal || with_body;
   constexpr bool axisymmetric = Shape::geometry == Geometry::axisymmetric;
+  // uGIMP adds its blocks by rows into sums field by field
+  // (scatter_lanes.hpp); other shapes one entry at a time into sums node by
+  // node (ScatterSums).
+  constexpr bool by_rows = scatters_by_rows<Shape>() && !with_affine && !axisymmetric;
+  using Sums = ScatterSums<by_rows>;
   const std::size_t n = range.end(P);
   const std::size_t nodes = g.mass.size();
-  const int threads = int(buffers.per_thread.size());
+  const int threads = buffers.threads();
+  std::ptrdiff_t row = 0;
+  if constexpr (by_rows) row = shape.grid->nodes_x();
+  [[maybe_unused]] std::size_t stride = nodes;
+  if constexpr (by_rows) stride = Sums::stride_of(nodes, row);
 
 #pragma omp parallel num_threads(threads)
   {
-    NodeSums* sums = buffers.per_thread[std::size_t(thread_id())].data();
-    std::fill(sums, sums + nodes, NodeSums{0.0, 0.0, 0.0, 0.0, 0.0});
+    auto& own = Sums::own(buffers, thread_id());
+    using Value = typename std::decay_t<decltype(own)>::value_type;
+    if (own.size() != Sums::size_of(nodes, row)) own.assign(Sums::size_of(nodes, row), Value{});
+    else std::fill(own.begin(), own.end(), Value{});
+    const Sums sum(own, stride);
+    [[maybe_unused]] ScatterLaneBatch rows;  // the batch's particles that go by rows, not yet added
+    [[maybe_unused]] bool batch_by_rows = false;  // every particle of the batch at hand
+    [[maybe_unused]] const ScatterFields fields{with_mass, with_momentum, with_internal, with_body};
+    [[maybe_unused]] const ScatterParticles particles{
+        P.mass.data(), values_of(P.velocity.data()), P.volume.data(), values_of(P.stress.data()),
+        with_body ? values_of(P.body_force.data()) : nullptr};
+    auto add_rows = [&] {
+      if constexpr (by_rows)
+        if (rows.pending != 0)
+          scatter_lanes(fields, particles, rows,
+                        ScatterRows{&sum(0, 0), &sum(1, 0), &sum(2, 0), &sum(3, 0), &sum(4, 0), row});
+    };
     [[maybe_unused]] double max_speed = 0.0;
     [[maybe_unused]] std::size_t first_unhealthy = P.size();
     [[maybe_unused]] ScanScreen screen;  // the scan's look at the batch of lanes at hand
@@ -208,6 +332,21 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
     auto map = [&](std::size_t p, auto&& entries, auto&& stencil_of, double gradient_bound) {
       if constexpr (scanning)
         max_speed = std::max(max_speed, scan->speed(p, stencil_of, max_speed, gradient_bound, screen));
+      if constexpr (by_rows && requires { entries.lane; }) {
+        // In a batch whose every particle goes by rows (its blocks noted by
+        // the batch's hook), added with the batch's others (add_rows), the
+        // same sums; a batch with a stretched domain goes entry by entry
+        // whole, which costs less than sorting it (callgrind, A = 1).
+        if (batch_by_rows) {
+          const int l = entries.lane;
+          if (rows.pending == 0) {
+            take_slots(entries.batch, rows);
+            rows.first = p - std::size_t(l);
+          }
+          rows.pending |= 1u << l;
+          return;
+        }
+      }
       const double m = P.mass[p];
       Vec2 momentum = Vec2::Zero(), body = Vec2::Zero();
       Mat2 volume_stress = Mat2::Zero();
@@ -217,23 +356,22 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
       if constexpr (with_internal) volume_stress = P.volume[p] * P.stress[p];
       if constexpr (with_internal && axisymmetric) volume_hoop_stress = P.volume[p] * P.hoop_stress[p];
       entries([&](int i, double w, const Vec2& gradient, const double& hoop = 0.0) {
-        NodeSums& node = sums[i];
-        if constexpr (with_mass) node.mass += w * m;
+        if constexpr (with_mass) sum(0, i) += w * m;
         if constexpr (with_affine) {
           const Vec2 affine = momentum + m * (P.affine_velocity[p] * (grid->node_position(i) - P.position[p]));
-          node.momentum_x += w * affine.x();
-          node.momentum_y += w * affine.y();
+          sum(1, i) += w * affine.x();
+          sum(2, i) += w * affine.y();
         } else if constexpr (with_momentum) {
-          node.momentum_x += w * momentum.x();
-          node.momentum_y += w * momentum.y();
+          sum(1, i) += w * momentum.x();
+          sum(2, i) += w * momentum.y();
         }
         if constexpr (with_force) {
           Vec2 f = Vec2::Zero();
           if constexpr (with_internal) f -= volume_stress * gradient;
           if constexpr (with_internal && axisymmetric) f.x() -= volume_hoop_stress * hoop;
           if constexpr (with_body) f += w * body;
-          node.force_x += f.x();
-          node.force_y += f.y();
+          sum(3, i) += f.x();
+          sum(4, i) += f.y();
         }
       });
     };
@@ -248,10 +386,38 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
       }
       return true;
     };
-    for_each_stencil(shape, range.first, n, scanning, usable, map,
-                     [&](std::size_t first, int count, const double* gradient_bounds) {
-                       if constexpr (scanning) scan->screen_lanes(first, count, gradient_bounds, max_speed, screen);
-                     });
+    for_each_stencil(
+        shape, range.first, n, scanning, usable, map,
+        [&](std::size_t first, int count, const double* gradient_bounds, auto&& batch) {
+          if constexpr (scanning) scan->screen_lanes(first, count, gradient_bounds, max_speed, screen);
+          // A batch whose every particle goes by rows and which the scan's
+          // screen finds healthy, inside and unable to raise the largest
+          // speed (its speed() would be 0, its healthy() true) is added
+          // whole, without a visit of each of its particles.
+          if constexpr (by_rows) {
+            batch_by_rows = true;
+            for (int l = 0; l < count; ++l) {
+              const std::ptrdiff_t block = shape.lane_block_first(batch, l);
+              if (block < 0) batch_by_rows = false;
+              rows.first_node[l] = block;
+            }
+            if (!batch_by_rows) return false;
+            if constexpr (scanning) {
+              if (!screen.valid) return false;
+              for (int l = 0; l < count; ++l)
+                if (screen.verdict.sound[l] == 0 || screen.verdict.may_set_speed[l] != 0 ||
+                    !shape.lane_inside(batch, l))
+                  return false;
+            }
+            take_slots(batch, rows);
+            rows.first = first;
+            rows.pending = (1u << count) - 1u;
+            add_rows();
+            return true;
+          }
+          return false;
+        },
+        add_rows);
     if constexpr (scanning) {
       // A largest and a lowest: the same whatever order the threads come in.
 #pragma omp critical
@@ -263,18 +429,16 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
     // The barrier after the particles above: all buffers are complete.
 #pragma omp for schedule(static)
     for (std::size_t i = 0; i < nodes; ++i) {
-      NodeSums total = buffers.per_thread[0][i];
+      double total[ScatterBuffers::kFields];
+      const Sums first(Sums::own(buffers, 0), stride);
+      for (int k = 0; k < ScatterBuffers::kFields; ++k) total[k] = first(k, i);
       for (int t = 1; t < threads; ++t) {
-        const NodeSums& b = buffers.per_thread[std::size_t(t)][i];
-        total.mass += b.mass;
-        total.momentum_x += b.momentum_x;
-        total.momentum_y += b.momentum_y;
-        total.force_x += b.force_x;
-        total.force_y += b.force_y;
+        const Sums other(Sums::own(buffers, t), stride);
+        for (int k = 0; k < ScatterBuffers::kFields; ++k) total[k] += other(k, i);
       }
-      if constexpr (with_mass) g.mass[i] = total.mass;
-      if constexpr (with_momentum) g.momentum[i] = Vec2(total.momentum_x, total.momentum_y);
-      if constexpr (with_force) g.force[i] = Vec2(total.force_x, total.force_y);
+      if constexpr (with_mass) g.mass[i] = total[0];
+      if constexpr (with_momentum) g.momentum[i] = Vec2(total[1], total[2]);
+      if constexpr (with_force) g.force[i] = Vec2(total[3], total[4]);
     }
   }
 }
@@ -370,30 +534,96 @@ enum ParticleUpdate : unsigned {
 // stage. New positions go to `position_out`, which may be P.position itself
 // (each particle reads its own position before writing it) or, when a later
 // stage still needs the old positions, another array.
+//
+// A shape whose lane kernel leaves 3 x 3 blocks of nodes takes its sums by
+// lanes (gather_lanes.hpp) from the nodes' a_g and v_g^L packed side by side
+// into `motion` (a scratch the caller keeps between steps; one of its own
+// without).
 template <unsigned Updates, class Shape>
 void grid_to_particles(const Shape& shape, const GridFields& g, Particles& P, double dt, double kick,
-                       Vec2* position_out = nullptr, ParticleRange range = {}) {
+                       Vec2* position_out = nullptr, ParticleRange range = {}, std::vector<double>* motion = nullptr) {
   constexpr bool with_velocity = Updates & kVelocity;
   constexpr bool with_position = Updates & kPosition;
   constexpr bool with_deformation = Updates & kDeformation;
   constexpr bool with_affine = Updates & kAffine;
   static_assert(!with_affine || with_velocity, "the affine field is a velocity update");
   constexpr bool axisymmetric = Shape::geometry == Geometry::axisymmetric;
+  constexpr bool by_rows = evaluates_lanes<Shape>() && !axisymmetric;
   if (position_out == nullptr) position_out = P.position.data();
   const std::size_t n = range.end(P);
+  [[maybe_unused]] std::vector<double> own_motion;
+  [[maybe_unused]] std::ptrdiff_t row = 0;
+  if constexpr (by_rows) {
+    // Four values a node, and rows of zeros past the last for a block at the
+    // grid's edge (as the sums field by field: ScatterSums).
+    row = shape.grid->nodes_x();
+    if (motion == nullptr) motion = &own_motion;
+    const std::size_t size = 4 * ScatterSums<true>::stride_of(g.mass.size(), row);
+    if (motion->size() != size) motion->assign(size, 0.0);
+  }
 #pragma omp parallel
   {
+    [[maybe_unused]] GatherLaneBatch lane_batch;
+    [[maybe_unused]] GatherLaneSums lane_sums;
+    [[maybe_unused]] bool batch_by_rows = false;  // lane_sums hold the batch at hand
+    // The batch's particles from `first`, in place for a whole batch, else
+    // copied (the spare lanes repeating the first; lanes.hpp).
+    [[maybe_unused]] GatherLaneParticles in_place;
+    [[maybe_unused]] struct {
+      alignas(64) double position[2 * kLanes], velocity[2 * kLanes], deformation_gradient[4 * kLanes];
+      alignas(64) double reference_volume[kLanes];
+    } copy;
+    auto lane_particles = [&](std::size_t first, int count) -> const GatherLaneParticles& {
+      if (count == kLanes) {
+        in_place = {values_of(P.position.data() + first), values_of(P.velocity.data() + first),
+                    values_of(P.deformation_gradient.data() + first), P.reference_volume.data() + first};
+        return in_place;
+      }
+      for (int l = 0; l < kLanes; ++l) {
+        const std::size_t q = copied_lane_particle(first, count, l);
+        std::copy_n(values_of(&P.position[q]), 2, copy.position + 2 * l);
+        std::copy_n(values_of(&P.velocity[q]), 2, copy.velocity + 2 * l);
+        std::copy_n(values_of(&P.deformation_gradient[q]), 4, copy.deformation_gradient + 4 * l);
+        copy.reference_volume[l] = P.reference_volume[q];
+      }
+      in_place = {copy.position, copy.velocity, copy.deformation_gradient, copy.reference_volume};
+      return in_place;
+    };
+    if constexpr (by_rows) {
+      double* m = motion->data();
+#pragma omp for schedule(static)
+      for (std::size_t i = 0; i < g.mass.size(); ++i) {
+        m[4 * i] = g.acceleration[i].x();
+        m[4 * i + 1] = g.acceleration[i].y();
+        m[4 * i + 2] = g.velocity[i].x();
+        m[4 * i + 3] = g.velocity[i].y();
+      }
+    }
     // `entries(f)` passes each entry of the particle's stencil to f.
-    auto update = [&](std::size_t p, auto&& entries) {
+    auto update = [&](std::size_t p, auto&& entries) __attribute__((always_inline)) {  // as the map's
       Vec2 acceleration = Vec2::Zero(), velocity = Vec2::Zero();
       Mat2 L = Mat2::Zero();  // the velocity gradient, for F and for APIC's C_p
       double hoop_rate = 0.0;
-      entries([&](int i, double w, const Vec2& gradient, const double& hoop = 0.0) {
-        if constexpr (with_velocity && !with_affine) acceleration += w * g.acceleration[i];
-        if constexpr (with_position || with_affine) velocity += w * g.velocity[i];
-        if constexpr (with_deformation || with_affine) L += g.velocity[i] * gradient.transpose();
-        if constexpr (with_deformation && axisymmetric) hoop_rate += hoop * g.velocity[i].x();
-      });
+      bool summed = false;
+      if constexpr (by_rows && with_affine && requires { entries.lane; }) {
+        // APIC's sums by lanes, in a batch whose every particle goes by rows
+        // (the batch's hook gathered them); the update entry by entry.
+        if (batch_by_rows) {
+          const int l = entries.lane;
+          acceleration = Vec2(lane_sums.acceleration[0][l], lane_sums.acceleration[1][l]);
+          velocity = Vec2(lane_sums.velocity[0][l], lane_sums.velocity[1][l]);
+          L << lane_sums.velocity_gradient[0][l], lane_sums.velocity_gradient[2][l],
+              lane_sums.velocity_gradient[1][l], lane_sums.velocity_gradient[3][l];
+          summed = true;
+        }
+      }
+      if (!summed)
+        entries([&](int i, double w, const Vec2& gradient, const double& hoop = 0.0) {
+          if constexpr (with_velocity && !with_affine) acceleration += w * g.acceleration[i];
+          if constexpr (with_position || with_affine) velocity += w * g.velocity[i];
+          if constexpr (with_deformation || with_affine) L += g.velocity[i] * gradient.transpose();
+          if constexpr (with_deformation && axisymmetric) hoop_rate += hoop * g.velocity[i].x();
+        });
       if constexpr (with_deformation) {
         P.deformation_gradient[p] = (Mat2::Identity() + dt * L) * P.deformation_gradient[p];
         double J = determinant(P.deformation_gradient[p]);
@@ -411,8 +641,44 @@ void grid_to_particles(const Shape& shape, const GridFields& g, Particles& P, do
       }
       if constexpr (with_position) position_out[p] = P.position[p] + dt * velocity;
     };
-    for_each_stencil(shape, range.first, n, false, [](std::size_t, auto) { return true; },
-                     [&](std::size_t p, auto&& entries, auto&&, double) { update(p, entries); });
+    // A batch whose every lane goes by rows is updated by lanes whole (no
+    // affine field), without a visit of each of its particles; a batch with
+    // a stretched CPDI domain goes entry by entry whole, which costs less
+    // than sorting it (callgrind, A = 1).
+    auto whole_batch = [&](std::size_t first, int count, const double*, auto&& batch) {
+      if constexpr (by_rows) {
+        batch_by_rows = false;
+        for (int k = 0; k < kLanes; ++k) {
+          const std::ptrdiff_t block = shape.lane_block_first(batch, k);
+          if (block < 0) return false;  // entry by entry, the whole batch
+          lane_batch.first_node[k] = block;
+        }
+        take_slots(batch, lane_batch);
+        batch_by_rows = true;
+        if constexpr (with_affine) {  // the sums by lanes, each particle then visited
+          gather_lanes(GatherLaneGrid{motion->data(), row, nullptr, dt, kick}, lane_batch, lane_sums);
+          return false;
+        }
+        gather_lanes(GatherLaneGrid{motion->data(), row, &lane_particles(first, count), dt, kick}, lane_batch,
+                     lane_sums);
+        const GatherLaneSums& out = lane_sums;
+        for (int l = 0; l < count; ++l) {
+          const std::size_t p = first + std::size_t(l);
+          if constexpr (with_deformation) {
+            double* F = values_of(&P.deformation_gradient[p]);
+            for (int k = 0; k < 4; ++k) F[k] = out.new_deformation_gradient[k][l];
+            P.volume[p] = out.new_volume[l];
+          }
+          if constexpr (with_velocity) P.velocity[p] = Vec2(out.new_velocity[0][l], out.new_velocity[1][l]);
+          if constexpr (with_position) position_out[p] = Vec2(out.new_position[0][l], out.new_position[1][l]);
+        }
+        return true;
+      }
+      return false;
+    };
+    for_each_stencil(
+        shape, range.first, n, false, [](std::size_t, auto) { return true; },
+        [&](std::size_t p, auto&& entries, auto&&, double) { update(p, entries); }, whole_batch);
   }
 }
 

@@ -133,15 +133,10 @@ void neo_hookean_stress_array(const NeoHookeanStressLaneParams& params, std::siz
 }  // namespace lanes::MPMVV_LANE_BUILD_NS
 
 #if defined(MPMVV_LANE_DISPATCH)
-void neo_hookean_scan_lanes(LaneBuild build, const NeoHookeanScanLaneParams& params,
-                            const NeoHookeanScanLaneInput& in, NeoHookeanScanLaneVerdict& out) {
-  MPMVV_LANE_BUILD_CALL(build, neo_hookean_scan_lanes(params, in, out));
-}
-
-void neo_hookean_scan_lanes(const NeoHookeanScanLaneParams& params, const NeoHookeanScanLaneInput& in,
-                            NeoHookeanScanLaneVerdict& out) {
-  neo_hookean_scan_lanes(lane_build(), params, in, out);
-}
+MPMVV_LANE_DISPATCH_OF(neo_hookean_scan_lanes,
+                       (const NeoHookeanScanLaneParams& params, const NeoHookeanScanLaneInput& in,
+                        NeoHookeanScanLaneVerdict& out),
+                       (params, in, out))
 
 std::size_t neo_hookean_lane_stress(LaneBuild build, const NeoHookeanStressLaneParams& params, std::size_t n,
                                     const double* deformation_gradient, double* stress) {

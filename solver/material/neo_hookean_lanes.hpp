@@ -94,23 +94,10 @@ std::size_t neo_hookean_lane_stress(LaneBuild build, const NeoHookeanStressLaneP
                                     const double* deformation_gradient, double* stress);
 
 // Each build's own, compiled for its instructions (solver/CMakeLists.txt).
-namespace lanes::avx512 {
-void neo_hookean_scan_lanes(const NeoHookeanScanLaneParams& params, const NeoHookeanScanLaneInput& in,
-                            NeoHookeanScanLaneVerdict& out);
-void neo_hookean_stress_array(const NeoHookeanStressLaneParams& params, std::size_t n,
-                              const double* deformation_gradient, double* stress, std::size_t& outside);
-}
-namespace lanes::avx2 {
-void neo_hookean_scan_lanes(const NeoHookeanScanLaneParams& params, const NeoHookeanScanLaneInput& in,
-                            NeoHookeanScanLaneVerdict& out);
-void neo_hookean_stress_array(const NeoHookeanStressLaneParams& params, std::size_t n,
-                              const double* deformation_gradient, double* stress, std::size_t& outside);
-}
-namespace lanes::baseline {
-void neo_hookean_scan_lanes(const NeoHookeanScanLaneParams& params, const NeoHookeanScanLaneInput& in,
-                            NeoHookeanScanLaneVerdict& out);
-void neo_hookean_stress_array(const NeoHookeanStressLaneParams& params, std::size_t n,
-                              const double* deformation_gradient, double* stress, std::size_t& outside);
-}
+MPMVV_LANE_KERNEL(void neo_hookean_scan_lanes(const NeoHookeanScanLaneParams& params,
+                                              const NeoHookeanScanLaneInput& in, NeoHookeanScanLaneVerdict& out))
+MPMVV_LANE_KERNEL(void neo_hookean_stress_array(const NeoHookeanStressLaneParams& params, std::size_t n,
+                                                const double* deformation_gradient, double* stress,
+                                                std::size_t& outside))
 
 }  // namespace mpmvv

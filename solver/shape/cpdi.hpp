@@ -367,6 +367,18 @@ struct CpdiShapeT {
       }
   }
 
+  // Where lane l's entries form a 3 x 3 block of nodes, slot a + 3 b at
+  // node first + a + b nodes_x (scatter_lanes.hpp), its first node; -1 for
+  // a wide lane (or a block that starts off the grid: its particle fails
+  // inside). A stencil of two columns or rows has zeros in the third.
+  std::ptrdiff_t lane_block_first(const LaneBatch& batch, int l) const
+    requires lanes
+  {
+    const CpdiLaneStencils& out = batch.out;
+    if (out.span_i[l] > 1 || out.span_j[l] > 1 || out.i0[l] < 0 || out.j0[l] < 0) return -1;
+    return grid->node(out.i0[l], out.j0[l]);
+  }
+
   // The bounds of sum_g |G_gp| the kernel gives with the lanes' entries, the
   // eight lanes' back to back (the spare lanes' the first's).
   const double* lane_gradient_bounds(const LaneBatch& batch) const

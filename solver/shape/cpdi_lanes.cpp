@@ -175,13 +175,8 @@ void cpdi_lane_stencils(const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiL
 }  // namespace lanes::MPMVV_LANE_BUILD_NS
 
 #if defined(MPMVV_LANE_DISPATCH)
-void cpdi_lane_stencils(LaneBuild build, const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiLaneStencils& out) {
-  MPMVV_LANE_BUILD_CALL(build, cpdi_lane_stencils(grid, in, out));
-}
-
-void cpdi_lane_stencils(const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiLaneStencils& out) {
-  cpdi_lane_stencils(lane_build(), grid, in, out);
-}
+MPMVV_LANE_DISPATCH_OF(cpdi_lane_stencils, (const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiLaneStencils& out),
+                       (grid, in, out))
 #endif
 
 }  // namespace mpmvv

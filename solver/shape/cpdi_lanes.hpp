@@ -96,14 +96,6 @@ void cpdi_lane_stencils(const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiL
 void cpdi_lane_stencils(LaneBuild build, const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiLaneStencils& out);
 
 // Each build's own, compiled for its instructions (solver/CMakeLists.txt).
-namespace lanes::avx512 {
-void cpdi_lane_stencils(const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiLaneStencils& out);
-}
-namespace lanes::avx2 {
-void cpdi_lane_stencils(const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiLaneStencils& out);
-}
-namespace lanes::baseline {
-void cpdi_lane_stencils(const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiLaneStencils& out);
-}
+MPMVV_LANE_KERNEL(void cpdi_lane_stencils(const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiLaneStencils& out))
 
 }  // namespace mpmvv

@@ -134,6 +134,10 @@ struct GimpShapeT {
   // Plane strain evaluates eight particles at a time by the lane kernel
   // (gimp_lanes.hpp), to the same bits as evaluate.
   static constexpr bool lanes = G == Geometry::plane_strain;
+  // Every lane's nodes are a 3 x 3 block but at the grid's edge (a domain is
+  // at most a cell wide): particle-to-grid adds them by rows (stages.hpp:
+  // scatters_by_rows).
+  static constexpr bool lane_blocks_only = lanes;
 
   // Eight particles' stencils in two steps, as for CPDI (cpdi.hpp:
   // compute_lanes). The gradient bound is CPDI's, which averages of the grid
@@ -187,6 +191,17 @@ struct GimpShapeT {
         f(g.node(out.node_i[a][l], out.node_j[b][l]), out.weight[slot][l],
           Vec2(out.gradient_x[slot][l], out.gradient_y[slot][l]));
       }
+  }
+
+  // Where lane l's nodes are a 3 x 3 block (scatter_lanes.hpp), its first
+  // node; -1 where the kernel held a node at the grid's edge (its weight 0).
+  std::ptrdiff_t lane_block_first(const LaneBatch& batch, int l) const
+    requires lanes
+  {
+    const GimpLaneStencils& out = batch.out;
+    const int i = out.node_i[0][l], j = out.node_j[0][l];
+    if (out.node_i[2][l] != i + 2 || out.node_j[2][l] != j + 2) return -1;
+    return grid->node(i, j);
   }
 
   // No bounds of sum_g |G_gp|: uGIMP's gradients are the grid basis's.

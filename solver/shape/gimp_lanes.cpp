@@ -107,13 +107,8 @@ void gimp_lane_stencils(const GimpLaneGrid& grid, const GimpLaneInput& in, GimpL
 }  // namespace lanes::MPMVV_LANE_BUILD_NS
 
 #if defined(MPMVV_LANE_DISPATCH)
-void gimp_lane_stencils(LaneBuild build, const GimpLaneGrid& grid, const GimpLaneInput& in, GimpLaneStencils& out) {
-  MPMVV_LANE_BUILD_CALL(build, gimp_lane_stencils(grid, in, out));
-}
-
-void gimp_lane_stencils(const GimpLaneGrid& grid, const GimpLaneInput& in, GimpLaneStencils& out) {
-  gimp_lane_stencils(lane_build(), grid, in, out);
-}
+MPMVV_LANE_DISPATCH_OF(gimp_lane_stencils, (const GimpLaneGrid& grid, const GimpLaneInput& in, GimpLaneStencils& out),
+                       (grid, in, out))
 #endif
 
 }  // namespace mpmvv

@@ -46,14 +46,6 @@ void gimp_lane_stencils(const GimpLaneGrid& grid, const GimpLaneInput& in, GimpL
 void gimp_lane_stencils(LaneBuild build, const GimpLaneGrid& grid, const GimpLaneInput& in, GimpLaneStencils& out);
 
 // Each build's own, compiled for its instructions (solver/CMakeLists.txt).
-namespace lanes::avx512 {
-void gimp_lane_stencils(const GimpLaneGrid& grid, const GimpLaneInput& in, GimpLaneStencils& out);
-}
-namespace lanes::avx2 {
-void gimp_lane_stencils(const GimpLaneGrid& grid, const GimpLaneInput& in, GimpLaneStencils& out);
-}
-namespace lanes::baseline {
-void gimp_lane_stencils(const GimpLaneGrid& grid, const GimpLaneInput& in, GimpLaneStencils& out);
-}
+MPMVV_LANE_KERNEL(void gimp_lane_stencils(const GimpLaneGrid& grid, const GimpLaneInput& in, GimpLaneStencils& out))
 
 }  // namespace mpmvv

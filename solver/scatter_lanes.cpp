@@ -1,0 +1,111 @@
+// The kernel of scatter_lanes.hpp (lane_vectors.hpp says how it is built).
+// Each line is the scalar line of particles_to_grid's map it repeats.
+#include "scatter_lanes.hpp"
+
+#include <utility>
+
+#include "lane_vectors.hpp"
+
+namespace mpmvv {
+
+namespace {
+
+using namespace lanes::MPMVV_LANE_BUILD_NS;
+
+// Three nodes of a block's row and the node after, whatever the build's width.
+using Row = Width<4>::Lanes;
+
+MPMVV_LANE_INLINE Row row_of(const double (*slot)[kLanes], int b, int l) {
+  return Row{slot[3 * b][l], slot[3 * b + 1][l], slot[3 * b + 2][l], 0.0};
+}
+
+MPMVV_LANE_INLINE void add_row(double* at, const Row& v) { store(at, load<Row>(at) + v); }
+
+template <bool Mass, bool Momentum, bool Internal, bool Body>
+void scatter(const ScatterParticles& P, const ScatterLaneBatch& in, const ScatterRows& out) {
+  // Restricted copies: no store to a sum can change where the next goes.
+  double* __restrict mass = out.mass;
+  double* __restrict momentum_x = out.momentum_x;
+  double* __restrict momentum_y = out.momentum_y;
+  double* __restrict force_x = out.force_x;
+  double* __restrict force_y = out.force_y;
+  const std::ptrdiff_t row = out.row;
+  for (int l = 0; l < kLanes; ++l) {
+    if (!((in.pending >> l) & 1u)) continue;
+    const std::size_t p = in.first + std::size_t(l);
+    // The particle's factors: m, m v_p, V_p sigma_p, m b_p.
+    const double m = P.mass[p];
+    double px = 0.0, py = 0.0, sxx = 0.0, syx = 0.0, sxy = 0.0, syy = 0.0, bx = 0.0, by = 0.0;
+    if constexpr (Momentum) px = m * P.velocity[2 * p], py = m * P.velocity[2 * p + 1];
+    if constexpr (Internal) {
+      const double V = P.volume[p];
+      sxx = V * P.stress[4 * p], syx = V * P.stress[4 * p + 1];
+      sxy = V * P.stress[4 * p + 2], syy = V * P.stress[4 * p + 3];
+    }
+    if constexpr (Body) bx = m * P.body_force[2 * p], by = m * P.body_force[2 * p + 1];
+    for (int b = 0; b < 3; ++b) {
+      const std::ptrdiff_t at = in.first_node[l] + b * row;
+      const Row w = row_of(in.weight, b, l);
+      if constexpr (Mass) add_row(mass + at, w * m);  // node.mass += w * m
+      if constexpr (Momentum) {
+        add_row(momentum_x + at, w * px);
+        add_row(momentum_y + at, w * py);
+      }
+      if constexpr (Internal || Body) {
+        // f = 0; f -= (V_p sigma_p) G_gp; f += w (m_p b_p); node.force += f
+        Row fx = {}, fy = {};
+        if constexpr (Internal) {
+          const Row gx = row_of(in.gradient_x, b, l), gy = row_of(in.gradient_y, b, l);
+          fx = fx - (sxx * gx + sxy * gy);
+          fy = fy - (syx * gx + syy * gy);
+        }
+        if constexpr (Body) {
+          fx = fx + w * bx;
+          fy = fy + w * by;
+        }
+        add_row(force_x + at, fx);
+        add_row(force_y + at, fy);
+      }
+    }
+  }
+}
+
+using Kernel = void (*)(const ScatterParticles&, const ScatterLaneBatch&, const ScatterRows&);
+
+// Kernel k adds the fields of the bits of k (mass, momentum, internal force,
+// body force); a plain array, since this unit emits no library function
+// (shape/lane_shared.hpp says why).
+template <std::size_t... K>
+struct Kernels {
+  static constexpr Kernel table[] = {&scatter<(K & 1u) != 0, (K & 2u) != 0, (K & 4u) != 0, (K & 8u) != 0>...};
+};
+template <std::size_t... K>
+Kernels<K...> kernels_of(std::index_sequence<K...>);
+
+}  // namespace
+
+namespace lanes::MPMVV_LANE_BUILD_NS {
+void scatter_lanes(const ScatterFields& fields, const ScatterParticles& P, const ScatterLaneBatch& batch,
+                   const ScatterRows& out) {
+  // One kernel per choice of fields, chosen once per batch.
+  using Table = decltype(kernels_of(std::make_index_sequence<16>{}));
+  const unsigned k = (fields.mass ? 1u : 0u) | (fields.momentum ? 2u : 0u) | (fields.internal_force ? 4u : 0u) |
+                     (fields.body_force ? 8u : 0u);
+  Table::table[k](P, batch, out);
+}
+}  // namespace lanes::MPMVV_LANE_BUILD_NS
+
+#if defined(MPMVV_LANE_DISPATCH)
+void scatter_lanes(LaneBuild build, const ScatterFields& fields, const ScatterParticles& P, ScatterLaneBatch& batch,
+                   const ScatterRows& out) {
+  MPMVV_LANE_BUILD_CALL(build, scatter_lanes(fields, P, batch, out));
+  batch.pending = 0;
+}
+
+void scatter_lanes(const ScatterFields& fields, const ScatterParticles& P, ScatterLaneBatch& batch,
+                   const ScatterRows& out) {
+  scatter_lanes(lane_build(), fields, P, batch, out);
+}
+#endif
+
+}  // namespace mpmvv
