@@ -108,7 +108,10 @@ RunOutcome run_time_loop(Stepper& stepper, const TimeLoopOptions& options, RunOb
     // Between two steps: the state is whole here, and saved when due.
     const bool signalled = stop_request().load(std::memory_order_relaxed);
     const bool paused = s.t >= checkpoints.pause_at;
-    if (checkpoints.save && (signalled || paused ||
+    // A run resumed and stopped before its first step leaves the restart
+    // file as it found it: the state in it is this state.
+    const bool unchanged = checkpoints.resume && s.steps == checkpoints.resume->steps;
+    if (checkpoints.save && !unchanged && (signalled || paused ||
                              (checkpoints.every_seconds > 0.0 &&
                               seconds_since(last_save) >= checkpoints.every_seconds))) {
       LoopState saved = s;

@@ -144,7 +144,8 @@ TEST(Restart, APausedAndResumedRunEndsWithTheBitsOfARunInOnePiece) {
   }
 }
 
-// A restart file holds the state of one run: --resume refuses it for another
+// A restart file holds the state of one run: --resume with a pause already
+// reached stops again without saving; --resume refuses it for another
 // configuration or thread count, naming what differs (exit 2, nothing run);
 // --resume-if-same starts that run from t = 0 and says why; an unreadable
 // file is named; and a solver whose state the file cannot hold (the implicit
@@ -157,6 +158,13 @@ TEST(Restart, OnlyTheSameRunGoesOnFromARestartFile) {
   ASSERT_TRUE(fs::exists(state));
 
   std::string said;
+  // Resumed with --pause-at at or before the saved time: it says it stops at
+  // once, and leaves the saved state as it was (no second save of it).
+  const fs::file_time_type saved = fs::last_write_time(state);
+  EXPECT_EQ(run("ring.toml", "-t 1 " + ring + " -o " + out.string() + " --resume --pause-at 0.03", &said), 130);
+  EXPECT_NE(said.find("stops again before its first step"), std::string::npos) << said;
+  EXPECT_EQ(fs::last_write_time(state), saved);
+
   EXPECT_EQ(run("ring.toml", "-t 1 " + ring + " --set amplitude=0.25 -o " + out.string() + " --resume", &said), 2);
   EXPECT_NE(said.find("another configuration"), std::string::npos) << said;
   EXPECT_NE(said.find("amplitude"), std::string::npos) << said;

@@ -211,9 +211,15 @@ RestartPlan restart_plan(const RunRequest& request, const std::string& output, c
       if (const std::string saved = root.attribute_string(name); saved != value && why_not.empty())
         why_not = fmt::format("it holds the state of a run with another {} ({}), which would not go on with the "
                               "same bits", name, first_difference(saved, value));
-    if (why_not.empty())
-      fmt::print(err, "mpmvv run: going on from {} (t = {:.6g} s, step {})\n", plan.path,
-                 root.attribute_double("time"), root.attribute_int("steps"));
+    if (why_not.empty()) {
+      const double saved_at = root.attribute_double("time");
+      fmt::print(err, "mpmvv run: going on from {} (t = {:.6g} s, step {})\n", plan.path, saved_at,
+                 root.attribute_int("steps"));
+      if (request.pause_at >= 0.0 && saved_at >= request.pause_at)
+        fmt::print(err, "mpmvv run: --pause-at {:.6g}: the saved state is at t = {:.6g} s already, so the run stops "
+                   "again before its first step (drop --pause-at or give a later time to go on)\n",
+                   request.pause_at, saved_at);
+    }
   } catch (const std::exception& e) {
     why_not = fmt::format("it cannot be read ({})", e.what());
   }

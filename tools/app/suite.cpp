@@ -993,9 +993,13 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
   const bool tty = isatty(fileno(stderr));
   const std::string prefix = ranks > 1 ? fmt::format("[rank {}] ", rank) : "";
   if (!request.quiet)
-    fmt::print(err, "{}mpmvv suite {}: {} cases ({} here, {} kept from an earlier run{}), {} at once, {} threads each -> {}\n",
+    fmt::print(err, "{}mpmvv suite {}: {} cases ({} here, {} kept from an earlier run{}), {} at once, {} threads each{} -> {}\n",
                prefix, suite.file, n, queue.size() + resumed + unselected, resumed,
                unselected ? fmt::format(", {} left pending by --only", unselected) : std::string(), jobs, threads,
+               suite.checkpoint_seconds > 0.0
+                   ? fmt::format(", each saving its state every {} (a rerun goes on from it)",
+                                 duration(suite.checkpoint_seconds))
+                   : std::string(),
                dir.string());
 
   struct sigaction action {};
