@@ -76,7 +76,7 @@ struct ScatterBuffers {
 // each array. Measured (callgrind, CPDI at A = 1, t = 0.40-0.44 s, where most
 // domains stretch past a cell and go entry by entry): with its sums field by
 // field that stage cost 2,262-2,303 instructions a particle-step (restricted
-// pointers or a type of its own for each field changed nothing) against 2,128
+// pointers or a type of its own for each field did not help) against 2,128
 // with NodeSums, whose five sums one address reaches. So CPDI keeps NodeSums
 // and adds entry by entry, and only uGIMP, whose stencils are blocks, adds by
 // rows (scatters_by_rows).
@@ -335,8 +335,8 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
       if constexpr (by_rows && requires { entries.lane; }) {
         // In a batch whose every particle goes by rows (its blocks noted by
         // the batch's hook), added with the batch's others (add_rows), the
-        // same sums; a batch with a stretched domain goes entry by entry
-        // whole, which costs less than sorting it (callgrind, A = 1).
+        // same sums; a batch with a lane whose nodes are no block (a node
+        // held at the grid's edge) goes entry by entry whole.
         if (batch_by_rows) {
           const int l = entries.lane;
           if (rows.pending == 0) {
@@ -600,7 +600,10 @@ void grid_to_particles(const Shape& shape, const GridFields& g, Particles& P, do
       }
     }
     // `entries(f)` passes each entry of the particle's stencil to f.
-    auto update = [&](std::size_t p, auto&& entries) __attribute__((always_inline)) {  // as the map's
+    // Inlined where it is visited: left out of line once the lanes' path
+    // grew the stage, a stretched CPDI batch's update cost 365 instructions a
+    // particle-step in the call alone (callgrind, A = 1, t = 0.40-0.44 s).
+    auto update = [&](std::size_t p, auto&& entries) __attribute__((always_inline)) {
       Vec2 acceleration = Vec2::Zero(), velocity = Vec2::Zero();
       Mat2 L = Mat2::Zero();  // the velocity gradient, for F and for APIC's C_p
       double hoop_rate = 0.0;
