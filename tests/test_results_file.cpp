@@ -313,6 +313,30 @@ TEST(Hdf5File, RowsWrittenInBlocksGiveTheBytesOfAWholeWrite) {
   EXPECT_EQ(read[2 * (kRows - 1) + 1], row_value(kRows - 1, 1));
 }
 
+// Two writes of the same content give the same bytes only if no object header
+// holds the clock: HDF5 stamps the root group, groups and datasets unless told
+// not to, and two writes either side of a second's tick then differ.
+TEST(Hdf5File, ObjectsCarryNoTimeStamps) {
+  const fs::path p = scratch("untimed.h5");
+  {
+    mpmvv::h5::File file = mpmvv::h5::File::create(p.string());
+    {
+      mpmvv::h5::Group root = file.root();
+      fill_content(root, false);
+    }
+    file.save();
+  }
+  const hid_t file = H5Fopen(p.string().c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(file, 0);
+  for (const char* object : {"/", "/particles", "/particles/position", "/time"}) {
+    H5O_info_t info;
+    ASSERT_GE(H5Oget_info_by_name(file, object, &info, H5P_DEFAULT), 0) << object;
+    EXPECT_EQ(info.ctime, 0) << object;
+    EXPECT_EQ(info.mtime, 0) << object;
+  }
+  H5Fclose(file);
+}
+
 // Saving while a group is open would leave HDF5 holding the file open; it is
 // refused with the reason, and nothing is written.
 TEST(Hdf5File, SavingWithAGroupOpenIsRefused) {
