@@ -7,6 +7,7 @@
 // walls there are exact.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <numbers>
@@ -24,16 +25,37 @@ struct AxisAlignedMotion {
   double wave_speed = 100.0;   // c = sqrt(E / rho_0) [m/s]
   double length = 1.0;         // L, the side of the square or the strip [m]
   bool one_dimensional = false;
+  // Separable (manufactured.hpp): the sines of X and Y, and the time
+  // functions T_x and T_y (the second factor of each is 0 in 1D).
+  static constexpr int kSpaceFactors = 2, kTimeFactors = 2;
 
   template <class S>
-  Eigen::Matrix<S, 2, 1> position(const Eigen::Matrix<S, 2, 1>& X, const S& t) const {
+  std::array<S, 2> space_factors(const Eigen::Matrix<S, 2, 1>& X) const {
+    using std::numbers::pi;
+    using std::sin;
+    const S L(length);
+    if (one_dimensional) return {sin(S(2.0 * pi) * X.x() / L), S(0.0)};
+    return {sin(S(pi) * X.x() / L), sin(S(pi) * X.y() / L)};
+  }
+  template <class S>
+  std::array<S, 2> time_factors(const S& t) const {
     using std::cos;
     using std::numbers::pi;
     using std::sin;
-    const S A(amplitude), c(wave_speed), L(length);
-    if (one_dimensional) return {X.x() + A * sin(S(2.0 * pi) * X.x() / L) * cos(c * S(pi) * t / L), X.y()};
-    return {X.x() + A * sin(S(pi) * X.x() / L) * sin(c * S(pi) * t / L),
-            X.y() + A * sin(S(pi) * X.y() / L) * sin(S(pi) * (S(2.0 / 3.0) + c * t / L))};
+    const S c(wave_speed), L(length);
+    if (one_dimensional) return {cos(c * S(pi) * t / L), S(0.0)};
+    return {sin(c * S(pi) * t / L), sin(S(pi) * (S(2.0 / 3.0) + c * t / L))};
+  }
+  template <class S>
+  Eigen::Matrix<S, 2, 1> position(const Eigen::Matrix<S, 2, 1>& X, const std::array<S, 2>& space,
+                                  const std::array<S, 2>& time) const {
+    const S A(amplitude);
+    if (one_dimensional) return {X.x() + A * space[0] * time[0], X.y()};
+    return {X.x() + A * space[0] * time[0], X.y() + A * space[1] * time[1]};
+  }
+  template <class S>
+  Eigen::Matrix<S, 2, 1> position(const Eigen::Matrix<S, 2, 1>& X, const S& t) const {
+    return position(X, space_factors(X), time_factors(t));
   }
   double length_scale() const { return length; }
   double time_scale() const { return length / wave_speed; }

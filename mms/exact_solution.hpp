@@ -10,6 +10,8 @@
 #include <variant>
 #include <vector>
 
+#include "factored_force.hpp"
+#include "force_field.hpp"
 #include "manufactured.hpp"
 #include "solver/model.hpp"
 
@@ -36,7 +38,34 @@ class ExactSolution {
   // The residual by finite differences with steps `step` times the motion's
   // length and time scales (Manufactured::check).
   virtual ResidualCheck check(const Vec2& X, double t, double step = kCheckStep) const = 0;
+  // The derived force as a field that keeps what it can of each point
+  // (factored_force.hpp), where the solution has one; derived_force_field
+  // gives every solution's.
+  virtual std::shared_ptr<ForceField> factored_force_field() const { return nullptr; }
 };
+
+// The derived force as a field that evaluates the solution point by point.
+class DerivedForceField final : public ForceField {
+ public:
+  explicit DerivedForceField(std::shared_ptr<const ExactSolution> solution) : solution_(std::move(solution)) {}
+  void place(std::size_t count, const std::vector<std::size_t>& index, const std::vector<Vec2>& at) override {
+    place_points(points_, count, index, at);
+  }
+  void evaluate(double t, std::vector<Vec2>& b) const override { solution_->body_forces(t, points_, b); }
+  std::size_t bytes() const override { return bytes_held(points_); }
+
+ private:
+  std::shared_ptr<const ExactSolution> solution_;
+  std::vector<Vec2> points_;
+};
+
+// The body force derived from `solution`'s motion and material (automatic
+// differentiation, manufactured.hpp), as a field: factored where the motion
+// is separable, point by point otherwise.
+inline std::shared_ptr<ForceField> derived_force_field(std::shared_ptr<const ExactSolution> solution) {
+  if (std::shared_ptr<ForceField> factored = solution->factored_force_field()) return factored;
+  return std::make_shared<DerivedForceField>(std::move(solution));
+}
 
 template <class Motion, class Material>
 class ManufacturedSolution final : public ExactSolution {
@@ -57,6 +86,10 @@ class ManufacturedSolution final : public ExactSolution {
   }
   ResidualCheck check(const Vec2& X, double t, double step = kCheckStep) const override {
     return m_.check(X, t, step);
+  }
+  std::shared_ptr<ForceField> factored_force_field() const override {
+    if constexpr (SeparableMotion<Motion>) return std::make_shared<FactoredForceField<Motion, Material>>(m_);
+    else return nullptr;
   }
   const Manufactured<Motion, Material>& manufactured() const { return m_; }
 

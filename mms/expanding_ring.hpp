@@ -12,6 +12,7 @@
 // tells a curved stressed free surface from the rest of the method.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <numbers>
@@ -50,14 +51,28 @@ struct ExpandingRingMotion {
     return S(c1()) + S(c2()) * R + S(c3()) * R * R;
   }
 
+  // Separable (manufactured.hpp): f(|X|), and the sine of t.
+  static constexpr int kSpaceFactors = 1, kTimeFactors = 1;
   template <class S>
-  Eigen::Matrix<S, 2, 1> position(const Eigen::Matrix<S, 2, 1>& X, const S& t) const {
+  std::array<S, 1> space_factors(const Eigen::Matrix<S, 2, 1>& X) const {
+    using std::sqrt;
+    return {profile(S(sqrt(X.x() * X.x() + X.y() * X.y())))};
+  }
+  template <class S>
+  std::array<S, 1> time_factors(const S& t) const {
     using std::numbers::pi;
     using std::sin;
-    using std::sqrt;
-    const S R = sqrt(X.x() * X.x() + X.y() * X.y());
-    const S stretch = S(1.0) + S(amplitude) * sin(S(wave_speed * pi / (2.0 * mean_radius())) * t) * profile(R);
+    return {sin(S(wave_speed * pi / (2.0 * mean_radius())) * t)};
+  }
+  template <class S>
+  Eigen::Matrix<S, 2, 1> position(const Eigen::Matrix<S, 2, 1>& X, const std::array<S, 1>& space,
+                                  const std::array<S, 1>& time) const {
+    const S stretch = S(1.0) + S(amplitude) * time[0] * space[0];
     return {stretch * X.x(), stretch * X.y()};
+  }
+  template <class S>
+  Eigen::Matrix<S, 2, 1> position(const Eigen::Matrix<S, 2, 1>& X, const S& t) const {
+    return position(X, space_factors(X), time_factors(t));
   }
   double length_scale() const { return outer_radius - inner_radius; }
   double time_scale() const { return 2.0 * mean_radius() / wave_speed; }

@@ -24,7 +24,6 @@
 #include <stdexcept>
 #include <vector>
 
-#include "exact_solution.hpp"
 #include "solver/model.hpp"
 
 namespace mpmvv::mms {
@@ -59,22 +58,6 @@ inline void place_points(std::vector<Vec2>& points, std::size_t count, const std
   points.resize(count);
   for (std::size_t k = 0; k < index.size(); ++k) points[index[k]] = at[k];
 }
-
-// The force derived from the motion and material by automatic
-// differentiation (manufactured.hpp).
-class DerivedForceField final : public ForceField {
- public:
-  explicit DerivedForceField(std::shared_ptr<const ExactSolution> solution) : solution_(std::move(solution)) {}
-  void place(std::size_t count, const std::vector<std::size_t>& index, const std::vector<Vec2>& at) override {
-    place_points(points_, count, index, at);
-  }
-  void evaluate(double t, std::vector<Vec2>& b) const override { solution_->body_forces(t, points_, b); }
-  std::size_t bytes() const override { return bytes_held(points_); }
-
- private:
-  std::shared_ptr<const ExactSolution> solution_;
-  std::vector<Vec2> points_;
-};
 
 // Where a particle samples the field.
 enum class ForceQuadrature {

@@ -18,10 +18,24 @@
 // of a motion whose displacement is tiny beside X (a steel bar: u / X ~ 1e-4),
 // where differences of positions would lose the displacement to round-off.
 // A Material provides stress(F, F_33) generic over the scalar (solver/material/).
+//
+// A separable Motion writes its position as a function of factors of X alone
+// and factors of t alone,
+//   static constexpr int kSpaceFactors, kTimeFactors;
+//   template <class S> std::array<S, kSpaceFactors> space_factors(const Eigen::Matrix<S, 2, 1>& X) const;
+//   template <class S> std::array<S, kTimeFactors> time_factors(const S& t) const;
+//   template <class S> Eigen::Matrix<S, 2, 1> position(const Eigen::Matrix<S, 2, 1>& X,
+//       const std::array<S, kSpaceFactors>&, const std::array<S, kTimeFactors>&) const;
+// with position(X, t) = position(X, space_factors(X), time_factors(t)). A
+// particle's factors of X do not change along its path: the derived force
+// keeps them, with their derivatives along X, and forms the time factors once
+// a step (factored_force.hpp); both give position(X, t)'s jets to the bit.
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <concepts>
 #include <limits>
 #include <vector>
 
@@ -106,8 +120,30 @@ inline ResidualVerdict judge_residuals(const std::vector<ResidualCheck>& fine, c
   return v;
 }
 
+template <class Motion>
+concept SeparableMotion = requires(const Motion& m, const Vec2& X) {
+  { m.position(X, m.space_factors(X), m.time_factors(0.0)) } -> std::same_as<Vec2>;
+  Motion::kSpaceFactors;
+  Motion::kTimeFactors;
+};
+
+// How many factors of each kind a motion has (none where it is not separable).
+template <class Motion>
+struct FactorCounts {
+  static constexpr int space = 0, time = 0;
+};
+template <SeparableMotion Motion>
+struct FactorCounts<Motion> {
+  static constexpr int space = Motion::kSpaceFactors, time = Motion::kTimeFactors;
+};
+
 template <class Motion, class Material>
 class Manufactured {
+  using Jet1 = Jet<double, 1>;
+  using Jet2 = Jet<double, 2>;
+  using TimeJet = Jet<Jet1, 1>;   // t with first and second derivative
+  using SpaceJet = Jet<Jet2, 2>;  // X with gradient and Hessian
+
  public:
   Manufactured(Motion motion, Material material, double density, Geometry geometry)
       : motion_(std::move(motion)), material_(material), density_(density), geometry_(geometry) {}
@@ -144,6 +180,37 @@ class Manufactured {
 
   Vec2 body_force(const Vec2& X, double t) const {
     return temporal(X, t).acceleration - divergence(spatial(X, t), X) / density_;
+  }
+
+  // A separable motion's factors of X at one point, each with its gradient
+  // and Hessian along X; and its factors of t, in the jet of t (for the
+  // acceleration) and as constants in the jet of X (for F and dF/dX).
+  using SpaceFactors = std::array<SpaceJet, FactorCounts<Motion>::space>;
+  struct TimeFactors {
+    std::array<TimeJet, FactorCounts<Motion>::time> in_time;
+    std::array<SpaceJet, FactorCounts<Motion>::time> in_space;
+  };
+  SpaceFactors space_factors(const Vec2& X) const
+    requires SeparableMotion<Motion>
+  {
+    return motion_.space_factors(space_variables(X));
+  }
+  TimeFactors time_factors(double t) const
+    requires SeparableMotion<Motion>
+  {
+    return {motion_.time_factors(time_variable(t)), motion_.time_factors(SpaceJet(t))};
+  }
+  // body_force(X, t) from the point's factors and the time's: the same jets,
+  // to the bit. The jet of t takes the factors of X as constants: the value
+  // part of every jet is the plain evaluation, whatever the nesting.
+  Vec2 body_force(const Vec2& X, const SpaceFactors& space, const TimeFactors& time) const
+    requires SeparableMotion<Motion>
+  {
+    std::array<TimeJet, FactorCounts<Motion>::space> space_in_time;
+    for (std::size_t k = 0; k < space.size(); ++k) space_in_time[k] = TimeJet(value_of(space[k]));
+    const Temporal a = temporal_of(motion_.position(time_constants(X), space_in_time, time.in_time));
+    const Spatial s = spatial_of(motion_.position(space_variables(X), space, time.in_space), X);
+    return a.acceleration - divergence(s, X) / density_;
   }
 
   // The fields without the acceleration and the body force (NaN there),
@@ -225,10 +292,6 @@ class Manufactured {
   }
 
  private:
-  using Jet1 = Jet<double, 1>;
-  using Jet2 = Jet<double, 2>;
-  using TimeJet = Jet<Jet1, 1>;   // t with first and second derivative
-  using SpaceJet = Jet<Jet2, 2>;  // X with gradient and Hessian
   using Vec2J = Eigen::Matrix<Jet2, 2, 1>;
   using Mat2J = Eigen::Matrix<Jet2, 2, 2>;
   using Jet0 = Jet<double, 0>;  // a value with no derivative, in the jets' arithmetic
@@ -258,10 +321,26 @@ class Manufactured {
     return geometry_ == Geometry::axisymmetric ? x.x() / X.x() : 1.0;
   }
 
+  // t seeded in the inner jet (for v) and in the outer jet (for a); X constant.
+  static TimeJet time_variable(double t) { return TimeJet(Jet1::variable(t, 0), {Jet1(1.0)}); }
+  static Eigen::Matrix<TimeJet, 2, 1> time_constants(const Vec2& X) {
+    return Eigen::Matrix<TimeJet, 2, 1>(TimeJet(X.x()), TimeJet(X.y()));
+  }
+  // X_J seeded in the inner jet (for F) and in the outer jet (for dF/dX).
+  static Eigen::Matrix<SpaceJet, 2, 1> space_variables(const Vec2& X) {
+    Eigen::Matrix<SpaceJet, 2, 1> XJ;
+    for (int J = 0; J < 2; ++J) {
+      std::array<Jet2, 2> outer{};
+      outer[std::size_t(J)] = Jet2(1.0);
+      XJ[J] = SpaceJet(Jet2::variable(X[J], J), outer);
+    }
+    return XJ;
+  }
+
   Temporal temporal(const Vec2& X, double t) const {
-    const TimeJet time(Jet1::variable(t, 0), {Jet1(1.0)});
-    const Eigen::Matrix<TimeJet, 2, 1> XJ(TimeJet(X.x()), TimeJet(X.y()));
-    const Eigen::Matrix<TimeJet, 2, 1> x = motion_.position(XJ, time);
+    return temporal_of(motion_.position(time_constants(X), time_variable(t)));
+  }
+  static Temporal temporal_of(const Eigen::Matrix<TimeJet, 2, 1>& x) {
     Temporal r;
     for (int i = 0; i < 2; ++i) {
       r.position[i] = x[i].v.v;
@@ -271,15 +350,9 @@ class Manufactured {
     return r;
   }
 
-  Spatial spatial(const Vec2& X, double t) const {
-    // X_J seeded in the inner jet (for F) and in the outer jet (for dF/dX).
-    Eigen::Matrix<SpaceJet, 2, 1> XJ;
-    for (int J = 0; J < 2; ++J) {
-      std::array<Jet2, 2> outer{};
-      outer[std::size_t(J)] = Jet2(1.0);
-      XJ[J] = SpaceJet(Jet2::variable(X[J], J), outer);
-    }
-    const Eigen::Matrix<SpaceJet, 2, 1> x = motion_.position(XJ, SpaceJet(t));
+  Spatial spatial(const Vec2& X, double t) const { return spatial_of(motion_.position(space_variables(X), SpaceJet(t)), X); }
+  // F, F_33 and the stresses from the position x(X) in the jet of X.
+  Spatial spatial_of(const Eigen::Matrix<SpaceJet, 2, 1>& x, const Vec2& X) const {
     Spatial s;
     for (int i = 0; i < 2; ++i)
       for (int K = 0; K < 2; ++K) s.F(i, K) = Jet2(x[i].v.d[K], {x[i].d[0].d[K], x[i].d[1].d[K]});

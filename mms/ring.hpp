@@ -11,6 +11,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -44,9 +45,11 @@ struct RingParameters {
 
 // The motion alone, generic over the scalar, for the generator
 // (manufactured.hpp): x = Q(alpha) X with alpha = g(t) h(|X|), the rotation
-// form of eq. 2.1 (it avoids atan2).
+// form of eq. 2.1 (it avoids atan2). Its factor of X alone is h(|X|), of t
+// alone g(t) (a separable motion, manufactured.hpp).
 struct RingMotion {
   RingParameters p;
+  static constexpr int kSpaceFactors = 1, kTimeFactors = 1;
 
   template <class S>
   S g(const S& t) const {
@@ -63,13 +66,26 @@ struct RingMotion {
     return q * q;
   }
   template <class S>
-  Eigen::Matrix<S, 2, 1> position(const Eigen::Matrix<S, 2, 1>& X, const S& t) const {
+  std::array<S, 1> space_factors(const Eigen::Matrix<S, 2, 1>& X) const {
+    using std::sqrt;
+    return {h(S(sqrt(X.x() * X.x() + X.y() * X.y())))};
+  }
+  template <class S>
+  std::array<S, 1> time_factors(const S& t) const {
+    return {g(t)};
+  }
+  template <class S>
+  Eigen::Matrix<S, 2, 1> position(const Eigen::Matrix<S, 2, 1>& X, const std::array<S, 1>& space,
+                                  const std::array<S, 1>& time) const {
     using std::cos;
     using std::sin;
-    using std::sqrt;
-    const S alpha = g(t) * h(S(sqrt(X.x() * X.x() + X.y() * X.y())));
+    const S alpha = time[0] * space[0];
     const S c = cos(alpha), s = sin(alpha);
     return {c * X.x() - s * X.y(), s * X.x() + c * X.y()};
+  }
+  template <class S>
+  Eigen::Matrix<S, 2, 1> position(const Eigen::Matrix<S, 2, 1>& X, const S& t) const {
+    return position(X, space_factors(X), time_factors(t));
   }
   double length_scale() const { return p.outer_radius - p.inner_radius; }
   double time_scale() const { return 1.0; }

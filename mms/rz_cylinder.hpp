@@ -10,6 +10,7 @@
 // and H: the rims are traction-free and roller walls at Z = 0, H are exact.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <numbers>
@@ -37,12 +38,28 @@ struct RzCylinderMotion {
     return S(16.0) * inner * inner * outer * outer;
   }
 
+  // Separable (manufactured.hpp): q(R) and cos(pi Z / H), and g(t).
+  static constexpr int kSpaceFactors = 2, kTimeFactors = 1;
   template <class S>
-  Eigen::Matrix<S, 2, 1> position(const Eigen::Matrix<S, 2, 1>& X, const S& t) const {
+  std::array<S, 2> space_factors(const Eigen::Matrix<S, 2, 1>& X) const {
     using std::cos;
     using std::numbers::pi;
-    const S g = S(0.5 * amplitude) * (S(1.0) - cos(S(2.0 * pi / period) * t));
-    return {X.x() * (S(1.0) + g * q(X.x()) * cos(S(pi / height) * X.y())), X.y()};
+    return {q(X.x()), cos(S(pi / height) * X.y())};
+  }
+  template <class S>
+  std::array<S, 1> time_factors(const S& t) const {
+    using std::cos;
+    using std::numbers::pi;
+    return {S(0.5 * amplitude) * (S(1.0) - cos(S(2.0 * pi / period) * t))};
+  }
+  template <class S>
+  Eigen::Matrix<S, 2, 1> position(const Eigen::Matrix<S, 2, 1>& X, const std::array<S, 2>& space,
+                                  const std::array<S, 1>& time) const {
+    return {X.x() * (S(1.0) + time[0] * space[0] * space[1]), X.y()};
+  }
+  template <class S>
+  Eigen::Matrix<S, 2, 1> position(const Eigen::Matrix<S, 2, 1>& X, const S& t) const {
+    return position(X, space_factors(X), time_factors(t));
   }
   double length_scale() const { return outer_radius - inner_radius; }
   double time_scale() const { return period; }

@@ -231,7 +231,7 @@ class MmsCase final : public SceneCase, private RunObserver {
     }
     if (!setup_.force_free && fault_ != Fault::no_body_force) {
       std::shared_ptr<mms::ForceField> field = setup_.fast_body_force;
-      if (!field) field = std::make_shared<mms::DerivedForceField>(setup_.solution);
+      if (!field) field = mms::derived_force_field(setup_.solution);
       stages.body_force = std::make_shared<mms::ManufacturedBodyForce>(field, force_quadrature(), setup_.geometry);
     }
     if (implicit()) {
