@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
-#include <limits>
 
 #include "../tensor.hpp"
 #include "neo_hookean_lanes.hpp"
@@ -44,11 +43,8 @@ struct NeoHookean {
   // then stops on) takes the scalar stress above.
   void cauchy_stress_array(std::size_t n, const Mat2* F, Mat2* sigma) const {
     if (neo_hookean_lane_stress({lambda, mu}, n, values_of(F), values_of(sigma)) == 0) return;
-    for (std::size_t p = 0; p < n; ++p) {
-      const double J = determinant(F[p]);
-      if (!(J >= std::numeric_limits<double>::min() && J <= std::numeric_limits<double>::max()))
-        sigma[p] = cauchy_stress(F[p]);
-    }
+    for (std::size_t p = 0; p < n; ++p)
+      if (!lane_stress_takes(determinant(F[p]))) sigma[p] = cauchy_stress(F[p]);
   }
 
   // Stored energy per reference volume, psi = mu/2 (I1 - 3) - mu ln J +

@@ -87,7 +87,7 @@ struct NeoHookeanStressKernel {
     load_interleaved(in.deformation_gradient + 4 * l0, F);
     const Lanes f00 = F[0], f10 = F[1], f01 = F[2], f11 = F[3];
     const Lanes J = (f00 * f11 - f01 * f10) * 1.0;
-    const Mask normal = (J >= 0x1p-1022) & (J <= 0x1.fffffffffffffp+1023);
+    const Mask normal = (J >= kLaneStressSmallestJ) & (J <= kLaneStressLargestJ);
     store(out.outside + l0, load<Lanes>(out.outside + l0) + (normal ? Lanes{} : Lanes{} + 1.0));
     const Lanes p = g.lambda * lane_log(J) / J;
     const Lanes shear = g.mu / J;

@@ -15,6 +15,7 @@
 #pragma once
 
 #include <cstddef>
+#include <limits>
 
 #include "../lanes.hpp"
 
@@ -87,6 +88,15 @@ void neo_hookean_scan_lanes(LaneBuild build, const NeoHookeanScanLaneParams& par
 struct NeoHookeanStressLaneParams {
   double lambda, mu;
 };
+
+// The J whose stress the lanes form: positive, finite and normal (lane_log's
+// domain), between the smallest normal and the largest finite double. The
+// kernel and the caller that forms the others' stresses test the same bounds.
+inline constexpr double kLaneStressSmallestJ = 0x1p-1022;
+inline constexpr double kLaneStressLargestJ = 0x1.fffffffffffffp+1023;
+static_assert(kLaneStressSmallestJ == std::numeric_limits<double>::min() &&
+              kLaneStressLargestJ == std::numeric_limits<double>::max());
+inline bool lane_stress_takes(double J) { return J >= kLaneStressSmallestJ && J <= kLaneStressLargestJ; }
 
 std::size_t neo_hookean_lane_stress(const NeoHookeanStressLaneParams& params, std::size_t n,
                                     const double* deformation_gradient, double* stress);
