@@ -59,6 +59,10 @@ struct ScatterBuffers {
   static constexpr int kFields = 5;
   std::vector<std::vector<NodeSums>> by_node;  // ScatterSums<false>
   std::vector<std::vector<double>> by_field;   // ScatterSums<true>
+  // The share of the last map's batches of lanes whose every stencil was a
+  // block of nodes (particles_to_grid: a shape whose stencils may be blocks
+  // adds by rows in a map that follows one where nearly all were).
+  double block_batch_share = 0.0;
 
   void resize(int threads, std::size_t /*nodes: each thread sizes its own*/) {
     by_node.assign(std::size_t(threads), {});
@@ -77,9 +81,9 @@ struct ScatterBuffers {
 // domains stretch past a cell and go entry by entry): with its sums field by
 // field that stage cost 2,262-2,303 instructions a particle-step (restricted
 // pointers or a type of its own for each field did not help) against 2,128
-// with NodeSums, whose five sums one address reaches. So CPDI keeps NodeSums
-// and adds entry by entry, and only uGIMP, whose stencils are blocks, adds by
-// rows (scatters_by_rows).
+// with NodeSums, whose five sums one address reaches. So a map adds by rows
+// only where (nearly) all its stencils are blocks: uGIMP's always, CPDI's
+// while its domains stay within a cell (scatter_by_rows).
 template <bool ByField>
 struct ScatterSums;
 
@@ -117,16 +121,35 @@ constexpr bool evaluates_lanes() {
   return false;
 }
 
-// True for a shape whose lane kernel leaves every stencil as a 3 x 3 block of
-// nodes but at the grid's edge (uGIMP: a domain of at most a cell's width),
-// so that particle-to-grid adds its batches by rows (scatter_lanes.hpp).
-// CPDI's domains stretch past a cell (most of them from t = 0.3 s of the
-// ring at A = 1), and a stage that goes by rows only in part costs CPDI more
-// than it saves (ScatterSums): CPDI adds entry by entry.
+// True for a shape whose lane kernel may leave a stencil as a 3 x 3 block of
+// nodes (lane_block_first), which particle-to-grid can add by rows
+// (scatter_lanes.hpp).
 template <class Shape>
-constexpr bool scatters_by_rows() {
-  if constexpr (requires { Shape::lane_blocks_only; }) return evaluates_lanes<Shape>() && Shape::lane_blocks_only;
+constexpr bool may_scatter_by_rows() {
+  if constexpr (evaluates_lanes<Shape>())
+    return requires(const Shape& s, const typename Shape::LaneBatch& b) { s.lane_block_first(b, 0); };
   return false;
+}
+
+// Whether a map adds by rows, decided once a map: always for a shape whose
+// stencils are blocks but at the grid's edge (uGIMP: a domain of at most a
+// cell's width, lane_blocks_only); for one whose domains may stretch past a
+// cell (CPDI: most of them from t = 0.3 s of the ring at A = 1), where the
+// last map found at least kRowsFromBlockShare of its batches all blocks. A
+// batch that is not goes entry by entry into the sums field by field, which
+// costs more than node by node (ScatterSums). Measured for CPDI (callgrind,
+// instructions a particle-step of a whole step, by rows against node by
+// node): 256 cells at A = 0.5, t = 0.02-0.04 s (every batch blocks) 1,104
+// against 1,162; 128 cells at A = 0.5, t = 0.40-0.44 s, 1,758 against 1,675;
+// at A = 1, t = 0.40-0.44 s, 2,286 against 2,132. Both layouts add the same
+// terms in the same order: the choice never changes a bit.
+inline constexpr double kRowsFromBlockShare = 0.9;
+inline constexpr std::size_t kBlockSample = 8;
+template <class Shape>
+bool scatter_by_rows(const ScatterBuffers& buffers) {
+  if constexpr (requires { Shape::lane_blocks_only; })
+    if (Shape::lane_blocks_only) return true;
+  return buffers.block_batch_share >= kRowsFromBlockShare;
 }
 
 // Lane l's stencil as the shape's evaluate gives it (the kernel's bound of
@@ -274,14 +297,10 @@ struct ScanScreen {
   NeoHookeanScanLaneVerdict verdict;
 };
 
-// Sums the particle quantities selected by `Fields` onto the grid and stores
-// them in `g`, overwriting those node fields (the others are left as they are).
-// kAffineMomentum reads the node positions from `grid`. With `scan` (a
-// ScanInMap) the map also scans the state it weighs, into scan->result.
-template <unsigned Fields, class Shape, class Scan = NoScan>
-void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& buffers,
-                       GridFields& g, ParticleRange range = {}, const GridGeometry* grid = nullptr,
-                       Scan* scan = nullptr) {
+// particles_to_grid (below) with its sums in the layout ByRows.
+template <unsigned Fields, bool ByRows, class Shape, class Scan>
+void map_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& buffers, GridFields& g, ParticleRange range,
+                 const GridGeometry* grid, Scan* scan) {
   constexpr bool scanning = !std::is_same_v<Scan, NoScan>;
   constexpr bool with_mass = Fields & kMass;
   constexpr bool with_momentum = Fields & kMomentum;
@@ -291,11 +310,14 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
   constexpr bool with_body = Fields & kBodyForce;
   constexpr bool with_force = with_internal || with_body;
   constexpr bool axisymmetric = Shape::geometry == Geometry::axisymmetric;
-  // uGIMP adds its blocks by rows into sums field by field
-  // (scatter_lanes.hpp); other shapes one entry at a time into sums node by
-  // node (ScatterSums).
-  constexpr bool by_rows = scatters_by_rows<Shape>() && !with_affine && !axisymmetric;
+  // Blocks by rows into sums field by field (scatter_lanes.hpp), or one entry
+  // at a time into sums node by node (ScatterSums); the batches that are all
+  // blocks are counted either way, for the next map's choice.
+  constexpr bool counts_blocks = may_scatter_by_rows<Shape>() && !with_affine && !axisymmetric;
+  constexpr bool by_rows = ByRows;
+  static_assert(!by_rows || counts_blocks);
   using Sums = ScatterSums<by_rows>;
+  std::size_t batches = 0, block_batches = 0;
   const std::size_t n = range.end(P);
   const std::size_t nodes = g.mass.size();
   const int threads = buffers.threads();
@@ -325,6 +347,7 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
     };
     [[maybe_unused]] double max_speed = 0.0;
     [[maybe_unused]] std::size_t first_unhealthy = P.size();
+    [[maybe_unused]] std::size_t own_batches = 0, own_block_batches = 0, seen_batches = 0;
     [[maybe_unused]] ScanScreen screen;  // the scan's look at the batch of lanes at hand
     // `entries(f)` passes each entry of the particle's stencil to f;
     // `stencil_of()` gives the stencil itself, which the scan asks for only
@@ -394,13 +417,24 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
           // screen finds healthy, inside and unable to raise the largest
           // speed (its speed() would be 0, its healthy() true) is added
           // whole, without a visit of each of its particles.
-          if constexpr (by_rows) {
-            batch_by_rows = true;
-            for (int l = 0; l < count; ++l) {
-              const std::ptrdiff_t block = shape.lane_block_first(batch, l);
-              if (block < 0) batch_by_rows = false;
-              rows.first_node[l] = block;
+          // Node by node the share is sampled, one batch in kBlockSample
+          // (its test is a tenth of the map's work where few are blocks);
+          // by rows every batch is looked at anyway.
+          if constexpr (counts_blocks) {
+            if (by_rows || seen_batches++ % kBlockSample == 0) {
+              // (the first lane that is no block settles it)
+              bool blocks = true;
+              for (int l = 0; l < count && blocks; ++l) {
+                const std::ptrdiff_t block = shape.lane_block_first(batch, l);
+                blocks = block >= 0;
+                if constexpr (by_rows) rows.first_node[l] = block;
+              }
+              ++own_batches;
+              own_block_batches += blocks;
+              if constexpr (by_rows) batch_by_rows = blocks;
             }
+          }
+          if constexpr (by_rows) {
             if (!batch_by_rows) return false;
             if constexpr (scanning) {
               if (!screen.valid) return false;
@@ -426,6 +460,12 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
         scan->result.first_unhealthy = std::min(scan->result.first_unhealthy, first_unhealthy);
       }
     }
+    if constexpr (counts_blocks) {
+#pragma omp atomic
+      batches += own_batches;
+#pragma omp atomic
+      block_batches += own_block_batches;
+    }
     // The barrier after the particles above: all buffers are complete.
 #pragma omp for schedule(static)
     for (std::size_t i = 0; i < nodes; ++i) {
@@ -441,6 +481,22 @@ void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& b
       if constexpr (with_force) g.force[i] = Vec2(total[3], total[4]);
     }
   }
+  if constexpr (counts_blocks) buffers.block_batch_share = batches > 0 ? double(block_batches) / double(batches) : 0.0;
+}
+
+// Sums the particle quantities selected by `Fields` onto the grid and stores
+// them in `g`, overwriting those node fields (the others are left as they are).
+// kAffineMomentum reads the node positions from `grid`. With `scan` (a
+// ScanInMap) the map also scans the state it weighs, into scan->result. The
+// layout of the sums is chosen once a map (scatter_by_rows).
+template <unsigned Fields, class Shape, class Scan = NoScan>
+void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& buffers, GridFields& g,
+                       ParticleRange range = {}, const GridGeometry* grid = nullptr, Scan* scan = nullptr) {
+  constexpr bool rows_possible = may_scatter_by_rows<Shape>() && !(Fields & kAffineMomentum) &&
+                                 Shape::geometry != Geometry::axisymmetric;
+  if constexpr (rows_possible)
+    if (scatter_by_rows<Shape>(buffers)) return map_to_grid<Fields, true>(shape, P, buffers, g, range, grid, scan);
+  map_to_grid<Fields, false>(shape, P, buffers, g, range, grid, scan);
 }
 
 // ---------------------------------------------------------------- grid update

@@ -14,6 +14,8 @@
 #include <cstdint>
 #include <limits>
 #include <random>
+#include <string>
+#include <type_traits>
 #include <vector>
 
 #include "solver/gather_lanes.hpp"
@@ -76,13 +78,19 @@ Particles random_particles(const GridGeometry& grid, std::size_t n, unsigned see
   return P;
 }
 
+// `block_share`: the share of all-block batches the map is told the last one
+// found, which decides CPDI's layout (scatter_by_rows: 1 by rows, 0 node by
+// node); uGIMP goes by rows whatever it is.
 template <class Shape>
-void expect_map_by_rows_as_entry_by_entry(const GridGeometry& grid, const Particles& P) {
+void expect_map_by_rows_as_entry_by_entry(const GridGeometry& grid, const Particles& P, double block_share) {
   using mpmvv::kBodyForce, mpmvv::kInternalForce, mpmvv::kMass, mpmvv::kMomentum;
   const Shape shape = Shape::bind(grid, P);
   const EntryByEntry<Shape> scalar(shape);
   mpmvv::ScatterBuffers buffers;
   buffers.resize(mpmvv::max_threads(), grid.node_count());
+  buffers.block_batch_share = block_share;
+  const bool expected_rows = block_share == 1.0 || std::is_same_v<Shape, GimpShape>;
+  EXPECT_EQ(mpmvv::scatter_by_rows<Shape>(buffers), expected_rows);
   GridFields rows, entries;
   rows.resize(grid.node_count());
   entries.resize(grid.node_count());
@@ -90,6 +98,11 @@ void expect_map_by_rows_as_entry_by_entry(const GridGeometry& grid, const Partic
   mpmvv::ScanInMap<EntryByEntry<Shape>, NeoHookean> scan_entries{scalar, kSolid, P, grid.h};
   mpmvv::particles_to_grid<kMass | kMomentum | kInternalForce | kBodyForce>(shape, P, buffers, rows, {}, nullptr,
                                                                             &scan_rows);
+  // The map counts its batches that were all blocks, for the next: most of
+  // these particles' domains are within a cell.
+  EXPECT_GT(buffers.block_batch_share, 0.2) << buffers.block_batch_share;
+  ::testing::Test::RecordProperty("block_batch_share", std::to_string(buffers.block_batch_share));
+  EXPECT_LE(buffers.block_batch_share, 1.0);
   mpmvv::particles_to_grid<kMass | kMomentum | kInternalForce | kBodyForce>(scalar, P, buffers, entries, {},
                                                                             nullptr, &scan_entries);
   EXPECT_EQ(scan_rows.result.first_unhealthy, scan_entries.result.first_unhealthy);
@@ -155,13 +168,13 @@ void expect_update_by_rows_as_entry_by_entry(const GridGeometry& grid, const Par
 TEST(TransferLanes, TheMapByRowsAddsWhatTheMapEntryByEntryAdds) {
   const GridGeometry grid = GridGeometry::walled(Vec2(-0.3, 0.1), 0.05, 18, 18);
   const Particles P = random_particles(grid, 1003, 5, true);  // 125 batches of 8 and 3 over
-  {
-    SCOPED_TRACE("CPDI");
-    expect_map_by_rows_as_entry_by_entry<CpdiShape>(grid, P);
+  for (const double share : {1.0, 0.0}) {
+    SCOPED_TRACE(share == 1.0 ? "CPDI by rows" : "CPDI node by node");
+    expect_map_by_rows_as_entry_by_entry<CpdiShape>(grid, P, share);
   }
   {
     SCOPED_TRACE("uGIMP");
-    expect_map_by_rows_as_entry_by_entry<GimpShape>(grid, P);
+    expect_map_by_rows_as_entry_by_entry<GimpShape>(grid, P, 0.0);
   }
 }
 

@@ -136,7 +136,7 @@ struct GimpShapeT {
   static constexpr bool lanes = G == Geometry::plane_strain;
   // Every lane's nodes are a 3 x 3 block but at the grid's edge (a domain is
   // at most a cell wide): particle-to-grid adds them by rows (stages.hpp:
-  // scatters_by_rows).
+  // scatter_by_rows).
   static constexpr bool lane_blocks_only = lanes;
 
   // Eight particles' stencils in two steps, as for CPDI (cpdi.hpp:
