@@ -247,6 +247,16 @@ void fill_content(mpmvv::h5::Group& root, bool by_rows) {
   }
 }
 
+// fill_content written to `p` by save().
+void save_content(const fs::path& p, bool by_rows) {
+  mpmvv::h5::File file = mpmvv::h5::File::create(p.string());
+  {
+    mpmvv::h5::Group root = file.root();
+    fill_content(root, by_rows);
+  }
+  file.save();
+}
+
 }  // namespace
 
 // save() writes the buffer HDF5 hands over as the file closes; it must be the
@@ -254,14 +264,7 @@ void fill_content(mpmvv::h5::Group& root, bool by_rows) {
 // image was taken before, at twice the memory).
 TEST(Hdf5File, SavedFileIsTheImageHdf5CopiesOut) {
   const fs::path saved = scratch("handed-over.h5");
-  {
-    mpmvv::h5::File file = mpmvv::h5::File::create(saved.string());
-    {
-      mpmvv::h5::Group root = file.root();
-      fill_content(root, false);
-    }
-    file.save();
-  }
+  save_content(saved, false);
   // The same file, built with the same properties but no callbacks, copied out.
   std::string copied;
   {
@@ -296,12 +299,7 @@ TEST(Hdf5File, RowsWrittenInBlocksGiveTheBytesOfAWholeWrite) {
   const fs::path by_rows_path = scratch("by-rows.h5");
   for (const bool by_rows : {false, true}) {
     const fs::path p = by_rows ? by_rows_path : scratch("whole.h5");
-    mpmvv::h5::File file = mpmvv::h5::File::create(p.string());
-    {
-      mpmvv::h5::Group root = file.root();
-      fill_content(root, by_rows);
-    }
-    file.save();
+    save_content(p, by_rows);
     files[by_rows] = bytes_of(p);
   }
   ASSERT_GT(files[0].size(), 2 * kRows * sizeof(double));
@@ -318,14 +316,7 @@ TEST(Hdf5File, RowsWrittenInBlocksGiveTheBytesOfAWholeWrite) {
 // not to, and two writes either side of a second's tick then differ.
 TEST(Hdf5File, ObjectsCarryNoTimeStamps) {
   const fs::path p = scratch("untimed.h5");
-  {
-    mpmvv::h5::File file = mpmvv::h5::File::create(p.string());
-    {
-      mpmvv::h5::Group root = file.root();
-      fill_content(root, false);
-    }
-    file.save();
-  }
+  save_content(p, false);
   const hid_t file = H5Fopen(p.string().c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   ASSERT_GE(file, 0);
   for (const char* object : {"/", "/particles", "/particles/position", "/time"}) {
