@@ -16,6 +16,7 @@
 #include <Eigen/Core>
 
 #include "force_field.hpp"
+#include "jet.hpp"
 #include "solver/material/neo_hookean.hpp"
 
 namespace mpmvv::mms {
@@ -47,8 +48,8 @@ struct AxisAlignedMotion {
     return {sin(c * S(pi) * t / L), sin(S(pi) * (S(2.0 / 3.0) + c * t / L))};
   }
   template <class S>
-  Eigen::Matrix<S, 2, 1> position(const Eigen::Matrix<S, 2, 1>& X, const std::array<S, 2>& space,
-                                  const std::array<S, 2>& time) const {
+  MPMVV_JET_INLINE Eigen::Matrix<S, 2, 1> position(const Eigen::Matrix<S, 2, 1>& X, const std::array<S, 2>& space,
+                                                   const std::array<S, 2>& time) const {
     const S A(amplitude);
     if (one_dimensional) return {X.x() + A * space[0] * time[0], X.y()};
     return {X.x() + A * space[0] * time[0], X.y() + A * space[1] * time[1]};

@@ -41,7 +41,11 @@ class ExactSolution {
   // The derived force as a field that keeps what it can of each point
   // (factored_force.hpp), where the solution has one; derived_force_field
   // gives every solution's.
-  virtual std::shared_ptr<ForceField> factored_force_field() const { return nullptr; }
+  // `build`: the vector build it runs (solver/lanes.hpp; tests compare them).
+  virtual std::shared_ptr<ForceField> factored_force_field(LaneBuild build = lane_build()) const {
+    (void)build;
+    return nullptr;
+  }
 };
 
 // The derived force as a field that evaluates the solution point by point.
@@ -62,8 +66,9 @@ class DerivedForceField final : public ForceField {
 // The body force derived from `solution`'s motion and material (automatic
 // differentiation, manufactured.hpp), as a field: factored where the motion
 // is separable, point by point otherwise.
-inline std::shared_ptr<ForceField> derived_force_field(std::shared_ptr<const ExactSolution> solution) {
-  if (std::shared_ptr<ForceField> factored = solution->factored_force_field()) return factored;
+inline std::shared_ptr<ForceField> derived_force_field(std::shared_ptr<const ExactSolution> solution,
+                                                       LaneBuild build = lane_build()) {
+  if (std::shared_ptr<ForceField> factored = solution->factored_force_field(build)) return factored;
   return std::make_shared<DerivedForceField>(std::move(solution));
 }
 
@@ -87,9 +92,12 @@ class ManufacturedSolution final : public ExactSolution {
   ResidualCheck check(const Vec2& X, double t, double step = kCheckStep) const override {
     return m_.check(X, t, step);
   }
-  std::shared_ptr<ForceField> factored_force_field() const override {
-    if constexpr (SeparableMotion<Motion>) return std::make_shared<FactoredForceField<Motion, Material>>(m_);
-    else return nullptr;
+  std::shared_ptr<ForceField> factored_force_field(LaneBuild build = lane_build()) const override {
+    if constexpr (SeparableMotion<Motion>) return std::make_shared<FactoredForceField<Motion, Material>>(m_, build);
+    else {
+      (void)build;
+      return nullptr;
+    }
   }
   const Manufactured<Motion, Material>& manufactured() const { return m_; }
 

@@ -21,6 +21,7 @@
 #include <Eigen/Core>
 
 #include "force_field.hpp"
+#include "jet.hpp"
 #include "solver/material/neo_hookean.hpp"
 
 namespace mpmvv::mms {
@@ -65,8 +66,8 @@ struct ExpandingRingMotion {
     return {sin(S(wave_speed * pi / (2.0 * mean_radius())) * t)};
   }
   template <class S>
-  Eigen::Matrix<S, 2, 1> position(const Eigen::Matrix<S, 2, 1>& X, const std::array<S, 1>& space,
-                                  const std::array<S, 1>& time) const {
+  MPMVV_JET_INLINE Eigen::Matrix<S, 2, 1> position(const Eigen::Matrix<S, 2, 1>& X, const std::array<S, 1>& space,
+                                                   const std::array<S, 1>& time) const {
     const S stretch = S(1.0) + S(amplitude) * time[0] * space[0];
     return {stretch * X.x(), stretch * X.y()};
   }

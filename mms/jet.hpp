@@ -120,6 +120,20 @@ MPMVV_JET_INLINE Jet<T, N> cos(const Jet<T, N>& a) {
   using std::sin;
   return chain(a, T(cos(a.v)), T(-sin(a.v)));
 }
+// sin x and cos x of one x together: a motion that takes both (a rotation)
+// makes one call of libm's sincos where it would make two (GCC merges
+// std::sin and std::cos of one double; jet_lanes.hpp calls sincos lane by
+// lane). Each is what sin(x) and cos(x) give, to the bit.
+template <class T>
+struct SinCos {
+  T sin, cos;
+};
+MPMVV_JET_INLINE SinCos<double> sin_cos(double x) { return {std::sin(x), std::cos(x)}; }
+template <class T, int N>
+MPMVV_JET_INLINE SinCos<Jet<T, N>> sin_cos(const Jet<T, N>& a) {
+  const auto inner = sin_cos(a.v);
+  return {chain(a, T(inner.sin), T(inner.cos)), chain(a, T(inner.cos), T(-inner.sin))};
+}
 template <class T, int N>
 MPMVV_JET_INLINE Jet<T, N> exp(const Jet<T, N>& a) {
   using std::exp;

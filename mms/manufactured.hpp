@@ -30,6 +30,9 @@
 // particle's factors of X do not change along its path: the derived force
 // keeps them, with their derivatives along X, and forms the time factors once
 // a step (factored_force.hpp); both give position(X, t)'s jets to the bit.
+// The three-argument position is declared MPMVV_JET_INLINE (jet.hpp): the
+// derived force runs it on four points in vector registers, which a call
+// would pass through memory, and GCC does not inline it there by itself.
 #pragma once
 
 #include <algorithm>
@@ -40,6 +43,7 @@
 #include <vector>
 
 #include "jet.hpp"
+#include "jet_lanes.hpp"
 #include "solver/geometry.hpp"
 #include "solver/material/stress.hpp"
 #include "solver/tensor.hpp"
@@ -145,6 +149,14 @@ class Manufactured {
   using SpaceJet = Jet<Jet2, 2>;  // X with gradient and Hessian
 
  public:
+  // The jets over another innermost scalar B (four lanes: jet_lanes.hpp).
+  template <class B>
+  using TimeJetOf = Jet<Jet<B, 1>, 1>;
+  template <class B>
+  using SpaceJetOf = Jet<Jet<B, 2>, 2>;
+  template <class B>
+  using Vec2Of = Eigen::Matrix<B, 2, 1>;
+
   Manufactured(Motion motion, Material material, double density, Geometry geometry)
       : motion_(std::move(motion)), material_(material), density_(density), geometry_(geometry) {}
 
@@ -185,11 +197,15 @@ class Manufactured {
   // A separable motion's factors of X at one point, each with its gradient
   // and Hessian along X; and its factors of t, in the jet of t (for the
   // acceleration) and as constants in the jet of X (for F and dF/dX).
-  using SpaceFactors = std::array<SpaceJet, FactorCounts<Motion>::space>;
-  struct TimeFactors {
-    std::array<TimeJet, FactorCounts<Motion>::time> in_time;
-    std::array<SpaceJet, FactorCounts<Motion>::time> in_space;
+  template <class B>
+  using SpaceFactorsOf = std::array<SpaceJetOf<B>, FactorCounts<Motion>::space>;
+  template <class B>
+  struct TimeFactorsOf {
+    std::array<TimeJetOf<B>, FactorCounts<Motion>::time> in_time;
+    std::array<SpaceJetOf<B>, FactorCounts<Motion>::time> in_space;
   };
+  using SpaceFactors = SpaceFactorsOf<double>;
+  using TimeFactors = TimeFactorsOf<double>;
   SpaceFactors space_factors(const Vec2& X) const
     requires SeparableMotion<Motion>
   {
@@ -202,15 +218,21 @@ class Manufactured {
   }
   // body_force(X, t) from the point's factors and the time's: the same jets,
   // to the bit. The jet of t takes the factors of X as constants: the value
-  // part of every jet is the plain evaluation, whatever the nesting.
-  Vec2 body_force(const Vec2& X, const SpaceFactors& space, const TimeFactors& time) const
+  // part of every jet is the plain evaluation, whatever the nesting. B is
+  // double, or four points in lanes (jet_lanes.hpp), each lane the same
+  // operations as one point's.
+  template <class B>
+  MPMVV_JET_INLINE Vec2Of<B> body_force(const Vec2Of<B>& X, const SpaceFactorsOf<B>& space,
+                                        const TimeFactorsOf<B>& time) const
     requires SeparableMotion<Motion>
   {
-    std::array<TimeJet, FactorCounts<Motion>::space> space_in_time;
-    for (std::size_t k = 0; k < space.size(); ++k) space_in_time[k] = TimeJet(value_of(space[k]));
-    const Temporal a = temporal_of(motion_.position(time_constants(X), space_in_time, time.in_time));
-    const Spatial s = spatial_of(motion_.position(space_variables(X), space, time.in_space), X);
-    return a.acceleration - divergence(s, X) / density_;
+    std::array<TimeJetOf<B>, FactorCounts<Motion>::space> space_in_time;
+    for (std::size_t k = 0; k < space.size(); ++k) space_in_time[k] = time_constant(base_value(space[k]));
+    const TemporalOf<B> a = temporal_of(motion_.position(time_constants(X), space_in_time, time.in_time));
+    const SpatialOf<B> s = spatial_of(motion_.position(space_variables(X), space, time.in_space), X);
+    const Vec2Of<B> div = divergence(s, X);
+    const B density(density_);
+    return Vec2Of<B>(a.acceleration[0] - div[0] / density, a.acceleration[1] - div[1] / density);
   }
 
   // The fields without the acceleration and the body force (NaN there),
@@ -297,17 +319,21 @@ class Manufactured {
   using Jet0 = Jet<double, 0>;  // a value with no derivative, in the jets' arithmetic
   using Mat0 = Eigen::Matrix<Jet0, 2, 2>;
 
-  struct Temporal {
-    Vec2 position, velocity, acceleration;
+  template <class B>
+  struct TemporalOf {
+    Vec2Of<B> position, velocity, acceleration;
   };
+  using Temporal = TemporalOf<double>;
   // F, F_33 and the stresses at X, each carrying its derivative along X.
-  struct Spatial {
-    Mat2J F;
-    Jet2 F33;
-    Stress<Jet2> sigma;
-    Mat2J P;
-    Jet2 P33;
+  template <class B>
+  struct SpatialOf {
+    Eigen::Matrix<Jet<B, 2>, 2, 2> F;
+    Jet<B, 2> F33;
+    Stress<Jet<B, 2>> sigma;
+    Eigen::Matrix<Jet<B, 2>, 2, 2> P;
+    Jet<B, 2> P33;
   };
+  using Spatial = SpatialOf<double>;
 
   template <class M>
   static Mat2 value(const M& m) {
@@ -323,16 +349,22 @@ class Manufactured {
 
   // t seeded in the inner jet (for v) and in the outer jet (for a); X constant.
   static TimeJet time_variable(double t) { return TimeJet(Jet1::variable(t, 0), {Jet1(1.0)}); }
-  static Eigen::Matrix<TimeJet, 2, 1> time_constants(const Vec2& X) {
-    return Eigen::Matrix<TimeJet, 2, 1>(TimeJet(X.x()), TimeJet(X.y()));
+  template <class B>
+  MPMVV_JET_INLINE static TimeJetOf<B> time_constant(const B& x) {
+    return TimeJetOf<B>(Jet<B, 1>(x, {}), {});
+  }
+  template <class B>
+  MPMVV_JET_INLINE static Eigen::Matrix<TimeJetOf<B>, 2, 1> time_constants(const Vec2Of<B>& X) {
+    return Eigen::Matrix<TimeJetOf<B>, 2, 1>(time_constant(X.x()), time_constant(X.y()));
   }
   // X_J seeded in the inner jet (for F) and in the outer jet (for dF/dX).
-  static Eigen::Matrix<SpaceJet, 2, 1> space_variables(const Vec2& X) {
-    Eigen::Matrix<SpaceJet, 2, 1> XJ;
+  template <class B>
+  MPMVV_JET_INLINE static Eigen::Matrix<SpaceJetOf<B>, 2, 1> space_variables(const Vec2Of<B>& X) {
+    Eigen::Matrix<SpaceJetOf<B>, 2, 1> XJ;
     for (int J = 0; J < 2; ++J) {
-      std::array<Jet2, 2> outer{};
-      outer[std::size_t(J)] = Jet2(1.0);
-      XJ[J] = SpaceJet(Jet2::variable(X[J], J), outer);
+      std::array<Jet<B, 2>, 2> outer{};
+      outer[std::size_t(J)] = Jet<B, 2>(1.0);
+      XJ[J] = SpaceJetOf<B>(Jet<B, 2>::variable(X[J], J), outer);
     }
     return XJ;
   }
@@ -340,8 +372,9 @@ class Manufactured {
   Temporal temporal(const Vec2& X, double t) const {
     return temporal_of(motion_.position(time_constants(X), time_variable(t)));
   }
-  static Temporal temporal_of(const Eigen::Matrix<TimeJet, 2, 1>& x) {
-    Temporal r;
+  template <class B>
+  MPMVV_JET_INLINE static TemporalOf<B> temporal_of(const Eigen::Matrix<TimeJetOf<B>, 2, 1>& x) {
+    TemporalOf<B> r;
     for (int i = 0; i < 2; ++i) {
       r.position[i] = x[i].v.v;
       r.velocity[i] = x[i].v.d[0];
@@ -352,15 +385,17 @@ class Manufactured {
 
   Spatial spatial(const Vec2& X, double t) const { return spatial_of(motion_.position(space_variables(X), SpaceJet(t)), X); }
   // F, F_33 and the stresses from the position x(X) in the jet of X.
-  Spatial spatial_of(const Eigen::Matrix<SpaceJet, 2, 1>& x, const Vec2& X) const {
-    Spatial s;
+  template <class B>
+  MPMVV_JET_INLINE SpatialOf<B> spatial_of(const Eigen::Matrix<SpaceJetOf<B>, 2, 1>& x, const Vec2Of<B>& X) const {
+    using J2 = Jet<B, 2>;
+    SpatialOf<B> s;
     for (int i = 0; i < 2; ++i)
-      for (int K = 0; K < 2; ++K) s.F(i, K) = Jet2(x[i].v.d[K], {x[i].d[0].d[K], x[i].d[1].d[K]});
+      for (int K = 0; K < 2; ++K) s.F(i, K) = J2(x[i].v.d[K], {x[i].d[0].d[K], x[i].d[1].d[K]});
     if (geometry_ == Geometry::axisymmetric) {
-      const Jet2 r(x[0].v.v, {x[0].d[0].v, x[0].d[1].v});
-      s.F33 = r / Jet2::variable(X.x(), 0);
+      const J2 r(x[0].v.v, {x[0].d[0].v, x[0].d[1].v});
+      s.F33 = r / J2::variable(X.x(), 0);
     } else {
-      s.F33 = Jet2(1.0);
+      s.F33 = J2(1.0);
     }
     s.sigma = material_.stress(s.F, s.F33);
     first_piola(s.F, s.F33, s.sigma, s.P, s.P33);
@@ -370,7 +405,7 @@ class Manufactured {
   // P = J sigma F^-T and P_33 = J sigma_33 / F_33, J = det F F_33, in the
   // arithmetic of either jet (spatial; state's value-only jets).
   template <class T>
-  static void first_piola(const Eigen::Matrix<T, 2, 2>& F, const T& F33, const Stress<T>& sigma,
+  MPMVV_JET_INLINE static void first_piola(const Eigen::Matrix<T, 2, 2>& F, const T& F33, const Stress<T>& sigma,
                           Eigen::Matrix<T, 2, 2>& P, T& P33) {
     const T det2 = F(0, 0) * F(1, 1) - F(0, 1) * F(1, 0);
     const T J = det2 * F33;
@@ -380,8 +415,9 @@ class Manufactured {
     P33 = J * sigma.out_of_plane / F33;
   }
 
-  Vec2 divergence(const Spatial& s, const Vec2& X) const {
-    Vec2 div(s.P(0, 0).d[0] + s.P(0, 1).d[1], s.P(1, 0).d[0] + s.P(1, 1).d[1]);
+  template <class B>
+  MPMVV_JET_INLINE Vec2Of<B> divergence(const SpatialOf<B>& s, const Vec2Of<B>& X) const {
+    Vec2Of<B> div(s.P(0, 0).d[0] + s.P(0, 1).d[1], s.P(1, 0).d[0] + s.P(1, 1).d[1]);
     if (geometry_ == Geometry::axisymmetric) {
       div.x() += (s.P(0, 0).v - s.P33.v) / X.x();
       div.y() += s.P(1, 0).v / X.x();

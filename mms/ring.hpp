@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "force_field.hpp"
+#include "jet.hpp"
 #include "solver/lane_math.hpp"
 #include "solver/material/neo_hookean.hpp"
 #include "solver/model.hpp"
@@ -75,12 +76,11 @@ struct RingMotion {
     return {g(t)};
   }
   template <class S>
-  Eigen::Matrix<S, 2, 1> position(const Eigen::Matrix<S, 2, 1>& X, const std::array<S, 1>& space,
-                                  const std::array<S, 1>& time) const {
-    using std::cos;
-    using std::sin;
+  MPMVV_JET_INLINE Eigen::Matrix<S, 2, 1> position(const Eigen::Matrix<S, 2, 1>& X, const std::array<S, 1>& space,
+                                                   const std::array<S, 1>& time) const {
     const S alpha = time[0] * space[0];
-    const S c = cos(alpha), s = sin(alpha);
+    const auto turn = sin_cos(alpha);
+    const S c = turn.cos, s = turn.sin;
     return {c * X.x() - s * X.y(), s * X.x() + c * X.y()};
   }
   template <class S>

@@ -19,6 +19,7 @@
 #include <Eigen/Core>
 
 #include "force_field.hpp"
+#include "jet.hpp"
 #include "solver/material/neo_hookean.hpp"
 
 namespace mpmvv::mms {
@@ -53,8 +54,8 @@ struct RzCylinderMotion {
     return {S(0.5 * amplitude) * (S(1.0) - cos(S(2.0 * pi / period) * t))};
   }
   template <class S>
-  Eigen::Matrix<S, 2, 1> position(const Eigen::Matrix<S, 2, 1>& X, const std::array<S, 2>& space,
-                                  const std::array<S, 1>& time) const {
+  MPMVV_JET_INLINE Eigen::Matrix<S, 2, 1> position(const Eigen::Matrix<S, 2, 1>& X, const std::array<S, 2>& space,
+                                                   const std::array<S, 1>& time) const {
     return {X.x() * (S(1.0) + time[0] * space[0] * space[1]), X.y()};
   }
   template <class S>
