@@ -83,16 +83,6 @@ MPMVV_JET_INLINE JetLanes atan2(const JetLanes& y, const JetLanes& x) {
 // A constant exponent (jet.hpp: pow of a jet by a jet) is the same in every lane.
 inline double value_of(const JetLanes& a) { return a.v[0]; }
 
-// The innermost scalar of a jet of any nesting: a plain number, or four lanes.
-template <class T>
-struct JetBase {
-  using type = T;
-};
-template <class T, int N>
-struct JetBase<Jet<T, N>> {
-  using type = typename JetBase<T>::type;
-};
-
 // The value part of a jet down to its innermost scalar (value_of for lanes).
 MPMVV_JET_INLINE double base_value(double x) { return x; }
 MPMVV_JET_INLINE const JetLanes& base_value(const JetLanes& x) { return x; }
