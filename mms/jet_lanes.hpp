@@ -27,7 +27,7 @@ struct JetLanes {
 
   JetLanes() = default;
   explicit JetLanes(double constant) : v(Vector{} + constant) {}
-  explicit JetLanes(Vector values) : v(values) {}
+  explicit JetLanes(const Vector& values) : v(values) {}
 
   // Lane l from values[l].
   MPMVV_JET_INLINE static JetLanes load(const double* values) {
