@@ -121,12 +121,13 @@ constexpr bool evaluates_lanes() {
   return false;
 }
 
-// True for a shape whose lane kernel may leave a stencil as a 3 x 3 block of
-// nodes (lane_block_first), which particle-to-grid can add by rows
-// (scatter_lanes.hpp).
-template <class Shape>
+// True for a map of `Fields` by a shape whose lane kernel may leave a
+// stencil as a 3 x 3 block of nodes (lane_block_first), which particle-to-grid
+// can add by rows (scatter_lanes.hpp): in plane strain, without the affine
+// momentum.
+template <unsigned Fields, class Shape>
 constexpr bool may_scatter_by_rows() {
-  if constexpr (evaluates_lanes<Shape>())
+  if constexpr (evaluates_lanes<Shape>() && !(Fields & kAffineMomentum) && Shape::geometry != Geometry::axisymmetric)
     return requires(const Shape& s, const typename Shape::LaneBatch& b) { s.lane_block_first(b, 0); };
   return false;
 }
@@ -313,7 +314,7 @@ void map_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& buffers
   // Blocks by rows into sums field by field (scatter_lanes.hpp), or one entry
   // at a time into sums node by node (ScatterSums); the batches that are all
   // blocks are counted either way, for the next map's choice.
-  constexpr bool counts_blocks = may_scatter_by_rows<Shape>() && !with_affine && !axisymmetric;
+  constexpr bool counts_blocks = may_scatter_by_rows<Fields, Shape>();
   constexpr bool by_rows = ByRows;
   static_assert(!by_rows || counts_blocks);
   using Sums = ScatterSums<by_rows>;
@@ -492,9 +493,7 @@ void map_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& buffers
 template <unsigned Fields, class Shape, class Scan = NoScan>
 void particles_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& buffers, GridFields& g,
                        ParticleRange range = {}, const GridGeometry* grid = nullptr, Scan* scan = nullptr) {
-  constexpr bool rows_possible = may_scatter_by_rows<Shape>() && !(Fields & kAffineMomentum) &&
-                                 Shape::geometry != Geometry::axisymmetric;
-  if constexpr (rows_possible)
+  if constexpr (may_scatter_by_rows<Fields, Shape>())
     if (scatter_by_rows<Shape>(buffers)) return map_to_grid<Fields, true>(shape, P, buffers, g, range, grid, scan);
   map_to_grid<Fields, false>(shape, P, buffers, g, range, grid, scan);
 }
