@@ -54,12 +54,19 @@ struct GatherKernel {
 
   template <int W>
   MPMVV_LANE_INLINE static void body(const Grid& g, const In& in, Out& out, int l0) {
+    if (in.block == 2) sums<W, 2>(g, in, out, l0);
+    else sums<W, 3>(g, in, out, l0);
+  }
+
+  // A block of N x N nodes.
+  template <int W, int N>
+  MPMVV_LANE_INLINE static void sums(const Grid& g, const In& in, Out& out, int l0) {
     using Lanes = typename Width<W>::Lanes;
     const Lanes zero = {};
     Lanes ax = zero, ay = zero, vx = zero, vy = zero;
     Lanes L00 = zero, L10 = zero, L01 = zero, L11 = zero;
-    for (int b = 0; b < 3; ++b)
-      for (int a = 0; a < 3; ++a) {
+    for (int b = 0; b < N; ++b)
+      for (int a = 0; a < N; ++a) {
         const int s = a + 3 * b;
         long long at[W];
         for (int l = 0; l < W; ++l) at[l] = in.first_node[l0 + l] + a + b * g.row;

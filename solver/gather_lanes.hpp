@@ -1,7 +1,7 @@
 // Grid-to-particle's sums (stages.hpp: grid_to_particles, eqs. 1.73 and 1.76
 // of 002_c3305cb8b1bc1490.txt) for eight particles at once, each in a lane
-// (lanes.hpp), whose stencils a lane kernel left as 3 x 3 blocks of nodes
-// (scatter_lanes.hpp: slot a + 3 b at node first + a + b row):
+// (lanes.hpp), whose stencils a lane kernel left as 3 x 3 or 2 x 2 blocks
+// of nodes (scatter_lanes.hpp: slot a + 3 b at node first + a + b row):
 //   a_p = sum_g S_gp a_g,  v_p^L = sum_g S_gp v_g^L,  L_p = sum_g v_g^L (x) G_gp.
 //
 // Why: the scalar update reads a node's a_g and v_g from two arrays and
@@ -29,6 +29,7 @@ struct GatherLaneBatch {
   const double (*weight)[kLanes];
   const double (*gradient_x)[kLanes];
   const double (*gradient_y)[kLanes];
+  int block = 3;  // nodes along a block's side: 3 (CPDI, uGIMP) or 2 (linear: slots 0, 1, 3, 4)
   alignas(32) long long first_node[kLanes];
 };
 

@@ -23,6 +23,14 @@ inline std::size_t copied_lane_particle(std::size_t first, int count, int l) {
   return first + std::size_t(l < count ? l : 0);
 }
 
+// A shape's batch of kLanes particles from `first` with its lane kernel's
+// stencils (shape/cpdi.hpp, gimp.hpp, linear.hpp: compute_lanes).
+template <class Stencils>
+struct LaneBatchOfStencils {
+  std::size_t first;
+  Stencils out;
+};
+
 enum class LaneBuild { baseline, avx2, avx512 };  // avx512: its F, DQ and VL extensions
 
 bool cpu_has(LaneBuild build);

@@ -12,16 +12,19 @@ namespace {
 
 using namespace lanes::MPMVV_LANE_BUILD_NS;
 
-// Three nodes of a block's row and the node after, whatever the build's width.
+// Three nodes of a block's row and the node after, whatever the build's width
+// (a row of two: the two nodes after).
 using Row = Width<4>::Lanes;
 
+template <int Rows>
 MPMVV_LANE_INLINE Row row_of(const double (*slot)[kLanes], int b, int l) {
+  if constexpr (Rows == 2) return Row{slot[3 * b][l], slot[3 * b + 1][l], 0.0, 0.0};
   return Row{slot[3 * b][l], slot[3 * b + 1][l], slot[3 * b + 2][l], 0.0};
 }
 
 MPMVV_LANE_INLINE void add_row(double* at, const Row& v) { store(at, load<Row>(at) + v); }
 
-template <bool Mass, bool Momentum, bool Internal, bool Body>
+template <int Rows, bool Mass, bool Momentum, bool Internal, bool Body>
 void scatter(const ScatterParticles& P, const ScatterLaneBatch& in, const ScatterRows& out) {
   // Restricted copies: no store to a sum can change where the next goes.
   double* __restrict mass = out.mass;
@@ -43,9 +46,9 @@ void scatter(const ScatterParticles& P, const ScatterLaneBatch& in, const Scatte
       sxy = V * P.stress[4 * p + 2], syy = V * P.stress[4 * p + 3];
     }
     if constexpr (Body) bx = m * P.body_force[2 * p], by = m * P.body_force[2 * p + 1];
-    for (int b = 0; b < 3; ++b) {
+    for (int b = 0; b < Rows; ++b) {
       const std::ptrdiff_t at = in.first_node[l] + b * row;
-      const Row w = row_of(in.weight, b, l);
+      const Row w = row_of<Rows>(in.weight, b, l);
       if constexpr (Mass) add_row(mass + at, w * m);  // node.mass += w * m
       if constexpr (Momentum) {
         add_row(momentum_x + at, w * px);
@@ -55,7 +58,7 @@ void scatter(const ScatterParticles& P, const ScatterLaneBatch& in, const Scatte
         // f = 0; f -= (V_p sigma_p) G_gp; f += w (m_p b_p); node.force += f
         Row fx = {}, fy = {};
         if constexpr (Internal) {
-          const Row gx = row_of(in.gradient_x, b, l), gy = row_of(in.gradient_y, b, l);
+          const Row gx = row_of<Rows>(in.gradient_x, b, l), gy = row_of<Rows>(in.gradient_y, b, l);
           fx = fx - (sxx * gx + sxy * gy);
           fy = fy - (syx * gx + syy * gy);
         }
@@ -73,11 +76,13 @@ void scatter(const ScatterParticles& P, const ScatterLaneBatch& in, const Scatte
 using Kernel = void (*)(const ScatterParticles&, const ScatterLaneBatch&, const ScatterRows&);
 
 // Kernel k adds the fields of the bits of k (mass, momentum, internal force,
-// body force); a plain array, since this unit emits no library function
+// body force) of blocks of 3 rows, and kernel 16 + k the same of 2 rows; a
+// plain array, since this unit emits no library function
 // (shape/lane_shared.hpp says why).
 template <std::size_t... K>
 struct Kernels {
-  static constexpr Kernel table[] = {&scatter<(K & 1u) != 0, (K & 2u) != 0, (K & 4u) != 0, (K & 8u) != 0>...};
+  static constexpr Kernel table[] = {
+      &scatter<(K & 16u) != 0 ? 2 : 3, (K & 1u) != 0, (K & 2u) != 0, (K & 4u) != 0, (K & 8u) != 0>...};
 };
 template <std::size_t... K>
 Kernels<K...> kernels_of(std::index_sequence<K...>);
@@ -88,9 +93,9 @@ namespace lanes::MPMVV_LANE_BUILD_NS {
 void scatter_lanes(const ScatterFields& fields, const ScatterParticles& P, const ScatterLaneBatch& batch,
                    const ScatterRows& out) {
   // One kernel per choice of fields, chosen once per batch.
-  using Table = decltype(kernels_of(std::make_index_sequence<16>{}));
+  using Table = decltype(kernels_of(std::make_index_sequence<32>{}));
   const unsigned k = (fields.mass ? 1u : 0u) | (fields.momentum ? 2u : 0u) | (fields.internal_force ? 4u : 0u) |
-                     (fields.body_force ? 8u : 0u);
+                     (fields.body_force ? 8u : 0u) | (batch.block == 2 ? 16u : 0u);
   Table::table[k](P, batch, out);
 }
 }  // namespace lanes::MPMVV_LANE_BUILD_NS

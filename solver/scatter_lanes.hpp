@@ -1,7 +1,8 @@
 // Particle-to-grid's sums (stages.hpp: particles_to_grid, eqs. 1.69-1.70 of
 // 002_c3305cb8b1bc1490.txt) for a batch of particles whose stencils a lane
 // kernel left as 3 x 3 blocks of nodes (shape/cpdi_lanes.hpp,
-// shape/gimp_lanes.hpp): slot a + 3 b at node first + a + b row.
+// shape/gimp_lanes.hpp), or 2 x 2 (shape/linear_lanes.hpp, in the same
+// layout): slot a + 3 b at node first + a + b row.
 //
 // Why: the nodes of a block's row lie side by side in each of the thread's
 // sum arrays, so a particle adds to a row's three nodes with one vector per
@@ -55,6 +56,7 @@ struct ScatterLaneBatch {
   const double (*weight)[kLanes];
   const double (*gradient_x)[kLanes];
   const double (*gradient_y)[kLanes];
+  int block = 3;  // nodes along a block's side: 3 (CPDI, uGIMP) or 2 (linear: slots 0, 1, 3, 4)
   std::size_t first = 0;
   unsigned pending = 0;
   std::ptrdiff_t first_node[kLanes];

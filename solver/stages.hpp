@@ -75,15 +75,15 @@ struct ScatterBuffers {
 // node (ScatterBuffers::by_node: the five sums of a node side by side, one
 // cache line) for a stage that adds one entry at a time; field by field
 // (by_field: five arrays `stride` apart, with room past the last node for the
-// row of a block at the grid's edge) for a stage that adds 3 x 3 blocks by
+// row of a block at the grid's edge) for a stage that adds blocks by
 // rows (scatter_lanes.hpp), where a block's row of nodes lies side by side in
 // each array. Measured (callgrind, CPDI at A = 1, t = 0.40-0.44 s, where most
 // domains stretch past a cell and go entry by entry): with its sums field by
 // field that stage cost 2,262-2,303 instructions a particle-step (restricted
 // pointers or a type of its own for each field did not help) against 2,128
 // with NodeSums, whose five sums one address reaches. So a map adds by rows
-// only where (nearly) all its stencils are blocks: uGIMP's always, CPDI's
-// while its domains stay within a cell (scatter_by_rows).
+// only where (nearly) all its stencils are blocks: uGIMP's and linear's
+// always, CPDI's while its domains stay within a cell (scatter_by_rows).
 template <bool ByField>
 struct ScatterSums;
 
@@ -122,7 +122,7 @@ constexpr bool evaluates_lanes() {
 }
 
 // True for a map of `Fields` by a shape whose lane kernel may leave a
-// stencil as a 3 x 3 block of nodes (lane_block_first), which particle-to-grid
+// stencil as a block of nodes (lane_block_first), which particle-to-grid
 // can add by rows (scatter_lanes.hpp): in plane strain, without the affine
 // momentum.
 template <unsigned Fields, class Shape>
@@ -134,7 +134,7 @@ constexpr bool may_scatter_by_rows() {
 
 // Whether a map adds by rows, decided once a map: always for a shape whose
 // stencils are blocks but at the grid's edge (uGIMP: a domain of at most a
-// cell's width, lane_blocks_only); for one whose domains may stretch past a
+// cell's width; linear: the cell's 2 x 2 nodes; lane_blocks_only); for one whose domains may stretch past a
 // cell (CPDI: most of them from t = 0.3 s of the ring at A = 1), where the
 // last map found at least kRowsFromBlockShare of its batches all blocks. A
 // batch that is not goes entry by entry into the sums field by field, which
@@ -204,12 +204,15 @@ struct NoLaneHook {};
 // stencil, and the batch and lane themselves, for a stage that takes a
 // block of nodes at once (particles_to_grid, scatter_lanes.hpp).
 // The slots a lane kernel left in its batch (S_gp and G_gp by slot and lane:
-// CPDI's and uGIMP's alike), for a transfer by rows.
+// CPDI's, uGIMP's and linear's alike), for a transfer by rows.
 template <class Batch, class Rows>
 void take_slots(const Batch& batch, Rows& rows) {
   rows.weight = batch.out.weight;
   rows.gradient_x = batch.out.gradient_x;
   rows.gradient_y = batch.out.gradient_y;
+  // Nodes along a block's side: linear's 2 (LinearLaneStencils::kBlock), else 3.
+  if constexpr (requires { decltype(batch.out)::kBlock; }) rows.block = decltype(batch.out)::kBlock;
+  else rows.block = 3;
 }
 
 template <class Shape>
@@ -590,7 +593,7 @@ enum ParticleUpdate : unsigned {
 // (each particle reads its own position before writing it) or, when a later
 // stage still needs the old positions, another array.
 //
-// A shape whose lane kernel leaves 3 x 3 blocks of nodes takes its sums by
+// A shape whose lane kernel leaves blocks of nodes (3 x 3; linear's 2 x 2) takes its sums by
 // lanes (gather_lanes.hpp) from the nodes' a_g and v_g^L packed side by side
 // into `motion` (a scratch the caller keeps between steps; one of its own
 // without).

@@ -1,4 +1,4 @@
-// The stencils of the lane kernels (solver/lanes.hpp: CPDI and uGIMP) against
+// The stencils of the lane kernels (solver/lanes.hpp: CPDI, uGIMP and linear) against
 // the scalar evaluate of their shapes, bit for bit, for every build of the
 // kernels this CPU can run: the explicit step takes its stencils from the
 // kernels, and its results are meant to be those of the scalar code to the
@@ -18,6 +18,7 @@
 #include "solver/shape/cpdi.hpp"
 #include "solver/shape/cpdi_lanes.hpp"
 #include "solver/shape/gimp.hpp"
+#include "solver/shape/linear.hpp"
 #include "solver/stages.hpp"  // list_lane
 
 namespace {
@@ -212,6 +213,34 @@ TEST(GimpLanes, EveryBuildGivesTheScalarStencilsBitForBit) {
     SCOPED_TRACE(mpmvv::name(build));
     expect_lanes_equal_evaluate(GimpShape::bind(grid, P), n, build);
   }
+}
+
+TEST(LinearLanes, EveryBuildGivesTheScalarStencilsBitForBit) {
+  // Centres anywhere between the walls, on them (the upper ones belong to
+  // the last cells), on a node and on a cell's edge; and outside: in the
+  // ghost layer and NaN.
+  const GridGeometry grid = GridGeometry::walled(Vec2(-0.3, 0.1), 0.05, 12, 10);
+  const Vec2 lo = grid.wall_lower(), hi = grid.wall_upper();
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> along_x(lo.x(), hi.x()), along_y(lo.y(), hi.y());
+  const std::size_t n = 203;  // 25 lanes of 8 and 3 over
+  Particles P;
+  P.resize(n);
+  for (std::size_t p = 0; p < n; ++p) P.position[p] = Vec2(along_x(rng), along_y(rng));
+  P.position[0] = hi;
+  P.position[1] = lo;
+  P.position[2] = grid.node_position(5, 4);
+  P.position[3] = Vec2(grid.node_position(7, 3).x(), along_y(rng));
+  P.position[4] = Vec2(lo.x() - 0.5 * grid.h, along_y(rng));
+  P.position[201] = Vec2(std::nan(""), along_y(rng));
+  const mpmvv::LinearShape shape = mpmvv::LinearShape::bind(grid, P);
+  ASSERT_FALSE(mpmvv::testing::lane_builds_of_this_cpu().empty());
+  for (LaneBuild build : mpmvv::testing::lane_builds_of_this_cpu()) {
+    SCOPED_TRACE(mpmvv::name(build));
+    expect_lanes_equal_evaluate(shape, n, build);
+  }
+  EXPECT_FALSE(shape.inside(4));
+  EXPECT_FALSE(shape.inside(201));
 }
 
 }  // namespace

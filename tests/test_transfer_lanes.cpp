@@ -1,10 +1,11 @@
 // The transfers by rows of nodes (solver/scatter_lanes.hpp, gather_lanes.hpp)
 // against the transfers entry by entry, bit for bit: particle-to-grid's node
-// sums and the time-step scan's verdict (by rows for uGIMP; CPDI's lanes
+// sums and the time-step scan's verdict (by rows for uGIMP and linear; CPDI's lanes
 // there add entry by entry, against its scalar stencils), and grid-to-particle's x_p, v_p,
 // F_p, V_p and APIC's C_p, over CPDI domains merged and stretched past a
 // cell, uGIMP at the grid's edge, a batch of fewer than eight, and particles
-// the scan leaves out; and each build of the kernels this CPU can run.
+// the scan leaves out; each build of the kernels this CPU can run; and a
+// map into buffers that earlier maps used.
 #include <gtest/gtest.h>
 
 #include "support.hpp"
@@ -12,6 +13,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <initializer_list>
 #include <limits>
 #include <random>
 #include <string>
@@ -23,6 +25,7 @@
 #include "solver/scatter_lanes.hpp"
 #include "solver/shape/cpdi.hpp"
 #include "solver/shape/gimp.hpp"
+#include "solver/shape/linear.hpp"
 #include "solver/stages.hpp"
 
 namespace {
@@ -89,7 +92,7 @@ void expect_map_by_rows_as_entry_by_entry(const GridGeometry& grid, const Partic
   mpmvv::ScatterBuffers buffers;
   buffers.resize(mpmvv::max_threads(), grid.node_count());
   buffers.block_batch_share = block_share;
-  const bool expected_rows = block_share == 1.0 || std::is_same_v<Shape, GimpShape>;
+  const bool expected_rows = block_share == 1.0 || !std::is_same_v<Shape, CpdiShape>;  // uGIMP, linear: always
   EXPECT_EQ(mpmvv::scatter_by_rows<Shape>(buffers), expected_rows);
   GridFields rows, entries;
   rows.resize(grid.node_count());
@@ -176,6 +179,10 @@ TEST(TransferLanes, TheMapByRowsAddsWhatTheMapEntryByEntryAdds) {
     SCOPED_TRACE("uGIMP");
     expect_map_by_rows_as_entry_by_entry<GimpShape>(grid, P, 0.0);
   }
+  {
+    SCOPED_TRACE("linear");
+    expect_map_by_rows_as_entry_by_entry<mpmvv::LinearShape>(grid, P, 0.0);
+  }
 }
 
 TEST(TransferLanes, TheUpdateByRowsGivesWhatTheUpdateEntryByEntryGives) {
@@ -188,6 +195,79 @@ TEST(TransferLanes, TheUpdateByRowsGivesWhatTheUpdateEntryByEntryGives) {
   {
     SCOPED_TRACE("uGIMP");
     expect_update_by_rows_as_entry_by_entry<GimpShape>(grid, P, 4);
+  }
+  {
+    SCOPED_TRACE("linear");
+    expect_update_by_rows_as_entry_by_entry<mpmvv::LinearShape>(grid, P, 5);
+  }
+}
+
+// The threads' scatter buffers are kept from map to map (ScatterBuffers):
+// after maps of particles elsewhere (the first thread's at the top of the
+// grid, the second's at the bottom, then everywhere), a map gives what
+// fresh buffers give, to the bit, in each layout of the sums and with 1, 2
+// and 3 threads; no sum of an earlier map is left in a node.
+template <class Shape>
+void expect_reused_buffers_as_fresh(const GridGeometry& grid, double block_share, int threads) {
+  using mpmvv::kBodyForce, mpmvv::kInternalForce, mpmvv::kMass, mpmvv::kMomentum;
+  constexpr unsigned kAll = kMass | kMomentum | kInternalForce | kBodyForce;
+  const std::size_t n = 403;
+  Particles apart = random_particles(grid, n, 21, false);
+  for (std::size_t p = 0; p < n; ++p) {
+    // y from cells 3-17 to 11-17 (the first half) or 3-9 (the second).
+    const double y = (apart.position[p].y() - grid.origin.y()) / grid.h;
+    apart.position[p].y() = grid.origin.y() + grid.h * ((p < n / 2 ? 11.0 : 3.0) + (y - 3.0) * 6.0 / 14.0);
+  }
+  const Particles spread = random_particles(grid, n, 22, false);
+  auto map = [&](const Particles& P, mpmvv::ScatterBuffers& buffers, GridFields& g) {
+    buffers.block_batch_share = block_share;
+    mpmvv::particles_to_grid<kAll>(Shape::bind(grid, P), P, buffers, g);
+  };
+  auto expect_same = [&](const GridFields& a, const GridFields& b) {
+    for (std::size_t i = 0; i < grid.node_count(); ++i) {
+      ASSERT_EQ(bits(a.mass[i]), bits(b.mass[i])) << "node " << i;
+      for (int c = 0; c < 2; ++c) {
+        ASSERT_EQ(bits(a.momentum[i][c]), bits(b.momentum[i][c])) << "node " << i;
+        ASSERT_EQ(bits(a.force[i][c]), bits(b.force[i][c])) << "node " << i;
+      }
+    }
+  };
+  mpmvv::ScatterBuffers reused;
+  reused.resize(threads, grid.node_count());
+  for (const Particles* P : std::initializer_list<const Particles*>{&apart, &spread, &apart}) {
+    GridFields again, fresh;
+    again.resize(grid.node_count());
+    fresh.resize(grid.node_count());
+    map(*P, reused, again);
+    mpmvv::ScatterBuffers new_buffers;
+    new_buffers.resize(threads, grid.node_count());
+    map(*P, new_buffers, fresh);
+    expect_same(again, fresh);
+    // Stale sums of the earlier map were left out, not merely small.
+    double mass = 0.0;
+    for (std::size_t i = 0; i < grid.node_count(); ++i) mass += again.mass[i];
+    double particles_mass = 0.0;
+    for (std::size_t p = 0; p < n; ++p) particles_mass += P->mass[p];
+    EXPECT_NEAR(mass, particles_mass, 1e-12 * particles_mass);
+  }
+}
+
+TEST(TransferLanes, AMapAfterOthersSumsWhatFreshBuffersSum) {
+  const GridGeometry grid = GridGeometry::walled(Vec2(-0.3, 0.1), 0.05, 18, 18);
+  for (const int threads : {1, 2, 3}) {
+    SCOPED_TRACE(std::to_string(threads) + " threads");
+    for (const double share : {1.0, 0.0}) {
+      SCOPED_TRACE(share == 1.0 ? "CPDI by rows" : "CPDI node by node");
+      expect_reused_buffers_as_fresh<CpdiShape>(grid, share, threads);
+    }
+    {
+      SCOPED_TRACE("uGIMP");
+      expect_reused_buffers_as_fresh<GimpShape>(grid, 0.0, threads);
+    }
+    {
+      SCOPED_TRACE("linear");
+      expect_reused_buffers_as_fresh<mpmvv::LinearShape>(grid, 0.0, threads);
+    }
   }
 }
 

@@ -299,10 +299,7 @@ struct CpdiShapeT {
   // leave the grid). `for_scan` asks the kernel for what lane_inside and
   // lane_gradient_bounds need (the time-step scan), `build` for a build of
   // the kernel (tests; by default the widest the CPU has).
-  struct LaneBatch {
-    std::size_t first;
-    CpdiLaneStencils out;
-  };
+  using LaneBatch = LaneBatchOfStencils<CpdiLaneStencils>;
 
   void compute_lanes(std::size_t first, int count, LaneBatch& batch, bool for_scan = true,
                      const LaneBuild* build = nullptr) const

@@ -142,10 +142,7 @@ struct GimpShapeT {
   // Eight particles' stencils in two steps, as for CPDI (cpdi.hpp:
   // compute_lanes). The gradient bound is CPDI's, which averages of the grid
   // basis do not need: -1.
-  struct LaneBatch {
-    std::size_t first;
-    GimpLaneStencils out;
-  };
+  using LaneBatch = LaneBatchOfStencils<GimpLaneStencils>;
 
   void compute_lanes(std::size_t first, int count, LaneBatch& batch, bool /*for_scan*/ = true,
                      const LaneBuild* build = nullptr) const

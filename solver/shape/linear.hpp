@@ -1,12 +1,16 @@
 // Standard MPM: the particle is a Dirac delta (eq. 1.88), so the effective
 // shape function is the bilinear hat of its cell, eqs. 1.86-1.87, with the
 // piecewise-constant gradient of eq. 1.89 (002_c3305cb8b1bc1490.txt section 1.6.1).
-// In r-z the point quadrature gives <S_g / r> = S_g(x_p) / r_p.
+// In r-z the point quadrature gives <S_g / r> = S_g(x_p) / r_p. In plane
+// strain the stencils come eight at a time from a lane kernel
+// (linear_lanes.hpp), to the same bits.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 
 #include "../particles.hpp"
+#include "linear_lanes.hpp"
 #include "stencil.hpp"
 
 namespace mpmvv {
@@ -88,6 +92,68 @@ struct LinearShapeT {
 
   // A material point has no domain: its half-vectors are zero.
   Mat2 domain(std::size_t) const { return Mat2::Zero(); }
+
+  // Plane strain evaluates eight particles at a time by the lane kernel
+  // (linear_lanes.hpp), to the same bits as evaluate; every lane's nodes are
+  // a 2 x 2 block, which the transfers take by rows (stages.hpp:
+  // scatter_by_rows, grid_to_particles).
+  static constexpr bool lanes = G == Geometry::plane_strain;
+  static constexpr bool lane_blocks_only = lanes;
+
+  using LaneBatch = LaneBatchOfStencils<LinearLaneStencils>;
+
+  void compute_lanes(std::size_t first, int count, LaneBatch& batch, bool /*for_scan*/ = true,
+                     const LaneBuild* build = nullptr) const
+    requires lanes
+  {
+    const GridGeometry& g = *grid;
+    const double* in = values_of(position + first);
+    LinearLaneCopy copy;
+    if (count < kLanes) {
+      for (int l = 0; l < kLanes; ++l)
+        std::copy_n(values_of(position + copied_lane_particle(first, count, l)), 2, copy.position + 2 * l);
+      in = copy.position;
+    }
+    batch.first = first;
+    const Vec2 wall_lower = g.wall_lower(), wall_upper = g.wall_upper();
+    const LinearLaneGrid lane_grid{g.origin.x(),   g.origin.y(),   g.h,            g.cells_x,     g.cells_y,
+                                   g.nodes_x(),    wall_lower.x(), wall_lower.y(), wall_upper.x(), wall_upper.y()};
+    linear_lane_stencils(build ? *build : lane_build(), lane_grid, in, batch.out);
+  }
+
+  // inside(p) of the batch's lane l.
+  bool lane_inside(const LaneBatch& batch, int l) const
+    requires lanes
+  {
+    return batch.out.inside[l] != 0;
+  }
+
+  // Lane l's entries as evaluate lists them, each passed to f(node, S_gp, G_gp).
+  template <class F>
+  void for_each_lane_entry(const LaneBatch& batch, int l, F&& f) const
+    requires lanes
+  {
+    const LinearLaneStencils& out = batch.out;
+    const int n00 = out.first_node[l], row = grid->nodes_x();
+    const int node[4] = {n00, n00 + 1, n00 + row, n00 + row + 1};
+    constexpr int kSlot[4] = {0, 1, 3, 4};
+    for (int k = 0; k < 4; ++k)
+      f(node[k], out.weight[kSlot[k]][l], Vec2(out.gradient_x[kSlot[k]][l], out.gradient_y[kSlot[k]][l]));
+  }
+
+  // Lane l's block, from its first node (always one: the cell's four nodes).
+  std::ptrdiff_t lane_block_first(const LaneBatch& batch, int l) const
+    requires lanes
+  {
+    return batch.out.first_node[l];
+  }
+
+  // No bounds of sum_g |G_gp|: the gradients are the grid basis's.
+  const double* lane_gradient_bounds(const LaneBatch&) const
+    requires lanes
+  {
+    return nullptr;
+  }
 };
 
 using LinearShape = LinearShapeT<Geometry::plane_strain>;

@@ -43,7 +43,7 @@ int main(int argc, char** argv) {
              cells, scheme, end_time, extra.empty() ? "" : ", " + fmt::format("{}", fmt::join(extra, ", ")), repeats);
   fmt::print("ns: wall time per particle-step, then the same for each stage (stage_times.hpp; other: set-up, the "
              "time loop, output, ledgers);\nbytes: what the particles, the stepper and its body force hold per "
-             "particle; CPDI and uGIMP stencils by the {} build of the lane kernels (solver/lanes.hpp; "
+             "particle; CPDI, uGIMP and linear stencils by the {} build of the lane kernels (solver/lanes.hpp; "
              "MPMVV_LANE_BUILD names another)\n",
              mpmvv::name(mpmvv::lane_build()));
   fmt::print("{:>10} {:>7} {:>9} {:>6} {:>16} {:>7} | {:>6} {:>6} {:>6} {:>6} {:>6} {:>7} {:>6} | {:>5}\n", "method",
