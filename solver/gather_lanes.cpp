@@ -47,6 +47,25 @@ MPMVV_LANE_INLINE void node_motion(const double* motion, const long long* at, ty
   }
 }
 
+// The inverse of load_interleaved for two values a lane: lane l's v[0] and
+// v[1] at a[2 l] and a[2 l + 1].
+template <class V>
+MPMVV_LANE_INLINE void store_pairs(double* a, const V (&v)[2]) {
+  constexpr int W = int(sizeof(V) / sizeof(double));
+  using Index = typename Width<W>::Mask;
+  if constexpr (W == 2) {
+    store(a, __builtin_shuffle(v[0], v[1], Index{0, 2}));
+    store(a + 2, __builtin_shuffle(v[0], v[1], Index{1, 3}));
+  } else if constexpr (W == 4) {
+    store(a, __builtin_shuffle(v[0], v[1], Index{0, 4, 1, 5}));
+    store(a + 4, __builtin_shuffle(v[0], v[1], Index{2, 6, 3, 7}));
+  } else {
+    static_assert(W == 8);
+    store(a, __builtin_shuffle(v[0], v[1], Index{0, 8, 1, 9, 2, 10, 3, 11}));
+    store(a + 8, __builtin_shuffle(v[0], v[1], Index{4, 12, 5, 13, 6, 14, 7, 15}));
+  }
+}
+
 struct GatherKernel {
   using Grid = GatherLaneGrid;
   using In = GatherLaneBatch;
@@ -101,18 +120,28 @@ struct GatherKernel {
     const Lanes a10 = 0.0 + g.dt * L10, a11 = 1.0 + g.dt * L11;
     const Lanes n00 = a00 * F[0] + a01 * F[1], n01 = a00 * F[2] + a01 * F[3];
     const Lanes n10 = a10 * F[0] + a11 * F[1], n11 = a10 * F[2] + a11 * F[3];
+    const Lanes volume = (n00 * n11 - n01 * n10) * load<Lanes>(P.reference_volume + l0);  // det F V_p0
+    Lanes v[2], x[2];
+    load_interleaved(P.velocity + 2 * l0, v);
+    load_interleaved(P.position + 2 * l0, x);
+    const Lanes new_v[2] = {v[0] + g.kick * ax, v[1] + g.kick * ay};
+    const Lanes new_x[2] = {x[0] + g.dt * vx, x[1] + g.dt * vy};
     store(out.new_deformation_gradient[0] + l0, n00);
     store(out.new_deformation_gradient[1] + l0, n10);
     store(out.new_deformation_gradient[2] + l0, n01);
     store(out.new_deformation_gradient[3] + l0, n11);
-    store(out.new_volume + l0, (n00 * n11 - n01 * n10) * load<Lanes>(P.reference_volume + l0));  // det F V_p0
-    Lanes v[2], x[2];
-    load_interleaved(P.velocity + 2 * l0, v);
-    load_interleaved(P.position + 2 * l0, x);
-    store(out.new_velocity[0] + l0, v[0] + g.kick * ax);
-    store(out.new_velocity[1] + l0, v[1] + g.kick * ay);
-    store(out.new_position[0] + l0, x[0] + g.dt * vx);
-    store(out.new_position[1] + l0, x[1] + g.dt * vy);
+    store(out.new_volume + l0, volume);
+    store(out.new_velocity[0] + l0, new_v[0]);
+    store(out.new_velocity[1] + l0, new_v[1]);
+    store(out.new_position[0] + l0, new_x[0]);
+    store(out.new_position[1] + l0, new_x[1]);
+    // Straight into the particles' arrays, once every lane's values are read.
+    const GatherLaneTargets& to = g.targets;
+    const Lanes new_F[4] = {n00, n10, n01, n11};
+    if (to.deformation_gradient) store_interleaved(to.deformation_gradient + 4 * l0, new_F);
+    if (to.volume) store(to.volume + l0, volume);
+    if (to.velocity) store_pairs(to.velocity + 2 * l0, new_v);
+    if (to.position) store_pairs(to.position + 2 * l0, new_x);
   }
 };
 

@@ -43,6 +43,18 @@ struct GatherLaneParticles {
   const double* reference_volume;
 };
 
+// Where the update goes besides GatherLaneSums' new_* (a batch of eight in
+// place): the particles' own arrays from the batch's first, in their layout
+// (x_p and v_p 2 a lane, F_p 4, V_p 1); a null array is not written. Each
+// lane's values are read before its own are written, so an array may be the
+// one the update reads (x_p, v_p and F_p in place).
+struct GatherLaneTargets {
+  double* position = nullptr;
+  double* velocity = nullptr;
+  double* deformation_gradient = nullptr;
+  double* volume = nullptr;
+};
+
 // The sums by lane: a_p, v_p^L and L_p (xx, yx, xy, yy: column by column);
 // and with the update, as grid_to_particles forms them:
 //   F_p <- (I + dt L_p) F_p, V_p = det(F_p) V_p0 (eqs. 1.74-1.75),
@@ -65,6 +77,7 @@ struct GatherLaneGrid {
   std::ptrdiff_t row;
   const GatherLaneParticles* particles;
   double dt, kick;
+  GatherLaneTargets targets = {};
 };
 void gather_lanes(const GatherLaneGrid& grid, const GatherLaneBatch& batch, GatherLaneSums& out);
 // With a given build, which the CPU must have (cpu_has).
