@@ -47,25 +47,6 @@ MPMVV_LANE_INLINE void node_motion(const double* motion, const long long* at, ty
   }
 }
 
-// The inverse of load_interleaved for two values a lane: lane l's v[0] and
-// v[1] at a[2 l] and a[2 l + 1].
-template <class V>
-MPMVV_LANE_INLINE void store_pairs(double* a, const V (&v)[2]) {
-  constexpr int W = int(sizeof(V) / sizeof(double));
-  using Index = typename Width<W>::Mask;
-  if constexpr (W == 2) {
-    store(a, __builtin_shuffle(v[0], v[1], Index{0, 2}));
-    store(a + 2, __builtin_shuffle(v[0], v[1], Index{1, 3}));
-  } else if constexpr (W == 4) {
-    store(a, __builtin_shuffle(v[0], v[1], Index{0, 4, 1, 5}));
-    store(a + 4, __builtin_shuffle(v[0], v[1], Index{2, 6, 3, 7}));
-  } else {
-    static_assert(W == 8);
-    store(a, __builtin_shuffle(v[0], v[1], Index{0, 8, 1, 9, 2, 10, 3, 11}));
-    store(a + 8, __builtin_shuffle(v[0], v[1], Index{4, 12, 5, 13, 6, 14, 7, 15}));
-  }
-}
-
 struct GatherKernel {
   using Grid = GatherLaneGrid;
   using In = GatherLaneBatch;
@@ -140,8 +121,8 @@ struct GatherKernel {
     const Lanes new_F[4] = {n00, n10, n01, n11};
     if (to.deformation_gradient) store_interleaved(to.deformation_gradient + 4 * l0, new_F);
     if (to.volume) store(to.volume + l0, volume);
-    if (to.velocity) store_pairs(to.velocity + 2 * l0, new_v);
-    if (to.position) store_pairs(to.position + 2 * l0, new_x);
+    if (to.velocity) store_interleaved(to.velocity + 2 * l0, new_v);
+    if (to.position) store_interleaved(to.position + 2 * l0, new_x);
   }
 };
 

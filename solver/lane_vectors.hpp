@@ -129,16 +129,24 @@ MPMVV_LANE_INLINE void load_interleaved(const double* a, V (&v)[S]) {
   }
 }
 
-// The inverse of load_interleaved (S = 4): value c of every lane from v[c]
-// into an array that holds four values per lane, one lane after another. A
+// The inverse of load_interleaved: value c of every lane from v[c] into an
+// array that holds S values per lane, one lane after another. For S = 4 a
 // 4 x W transpose by the shuffles each width does in one instruction (the
 // unpacks of pairs, then whole halves or quarters), each row stored as it
-// is formed.
-template <class V>
-MPMVV_LANE_INLINE void store_interleaved(double* a, const V (&v)[4]) {
+// is formed; for S = 2 the lanes' pairs, half a vector's lanes at a time.
+template <class V, int S>
+MPMVV_LANE_INLINE void store_interleaved(double* a, const V (&v)[S]) {
   constexpr int W = int(sizeof(V) / sizeof(double));
   using Index = typename Width<W>::Mask;
-  if constexpr (W == 2) {
+  static_assert(S == 2 || S == 4);
+  if constexpr (S == 2) {
+    // Lane l's pair from v[0][l] and v[1][l] (index W + l in the shuffle).
+    constexpr Index low = []<std::size_t... k>(std::index_sequence<k...>) {
+      return Index{(long long)(k % 2 == 0 ? k / 2 : W + k / 2)...};
+    }(std::make_index_sequence<W>{});
+    store(a, __builtin_shuffle(v[0], v[1], low));
+    store(a + W, __builtin_shuffle(v[0], v[1], low + W / 2));
+  } else if constexpr (W == 2) {
     store(a, __builtin_shuffle(v[0], v[1], Index{0, 2}));
     store(a + 2, __builtin_shuffle(v[2], v[3], Index{0, 2}));
     store(a + 4, __builtin_shuffle(v[0], v[1], Index{1, 3}));
