@@ -12,17 +12,21 @@ namespace {
 
 using namespace lanes::MPMVV_LANE_BUILD_NS;
 
-// Three nodes of a block's row and the node after, whatever the build's width
-// (a row of two: the two nodes after).
-using Row = Width<4>::Lanes;
+// A block's row of nodes as one vector, whatever the build's width: three
+// nodes and the node after, or a row of two.
+template <int Rows>
+using RowOf = typename Width<Rows == 2 ? 2 : 4>::Lanes;
 
 template <int Rows>
-MPMVV_LANE_INLINE Row row_of(const double (*slot)[kLanes], int b, int l) {
-  if constexpr (Rows == 2) return Row{slot[3 * b][l], slot[3 * b + 1][l], 0.0, 0.0};
-  return Row{slot[3 * b][l], slot[3 * b + 1][l], slot[3 * b + 2][l], 0.0};
+MPMVV_LANE_INLINE RowOf<Rows> row_of(const double (*slot)[kLanes], int b, int l) {
+  if constexpr (Rows == 2) return RowOf<Rows>{slot[3 * b][l], slot[3 * b + 1][l]};
+  else return RowOf<Rows>{slot[3 * b][l], slot[3 * b + 1][l], slot[3 * b + 2][l], 0.0};
 }
 
-MPMVV_LANE_INLINE void add_row(double* at, const Row& v) { store(at, load<Row>(at) + v); }
+template <class Row>
+MPMVV_LANE_INLINE void add_row(double* at, const Row& v) {
+  store(at, load<Row>(at) + v);
+}
 
 template <int Rows, bool Mass, bool Momentum, bool Internal, bool Body>
 void scatter(const ScatterParticles& P, const ScatterLaneBatch& in, const ScatterRows& out) {
@@ -33,6 +37,7 @@ void scatter(const ScatterParticles& P, const ScatterLaneBatch& in, const Scatte
   double* __restrict force_x = out.force_x;
   double* __restrict force_y = out.force_y;
   const std::ptrdiff_t row = out.row;
+  using Row = RowOf<Rows>;
   for (int l = 0; l < kLanes; ++l) {
     if (!((in.pending >> l) & 1u)) continue;
     const std::size_t p = in.first + std::size_t(l);
