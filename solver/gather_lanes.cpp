@@ -83,14 +83,18 @@ struct GatherKernel {
         L10 = L10 + m[3] * gx;
         L11 = L11 + m[3] * gy;
       }
-    store(out.acceleration[0] + l0, ax);
-    store(out.acceleration[1] + l0, ay);
-    store(out.velocity[0] + l0, vx);
-    store(out.velocity[1] + l0, vy);
-    store(out.velocity_gradient[0] + l0, L00);
-    store(out.velocity_gradient[1] + l0, L10);
-    store(out.velocity_gradient[2] + l0, L01);
-    store(out.velocity_gradient[3] + l0, L11);
+    const GatherLaneTargets& to = g.targets;
+    const bool in_place = to.position || to.velocity || to.deformation_gradient || to.volume;
+    if (!in_place) {
+      store(out.acceleration[0] + l0, ax);
+      store(out.acceleration[1] + l0, ay);
+      store(out.velocity[0] + l0, vx);
+      store(out.velocity[1] + l0, vy);
+      store(out.velocity_gradient[0] + l0, L00);
+      store(out.velocity_gradient[1] + l0, L10);
+      store(out.velocity_gradient[2] + l0, L01);
+      store(out.velocity_gradient[3] + l0, L11);
+    }
     if (g.particles == nullptr) return;
     const GatherLaneParticles& P = *g.particles;
     // (I + dt L) F, each entry the two-term sum of Eigen's product, with
@@ -107,17 +111,19 @@ struct GatherKernel {
     load_interleaved(P.position + 2 * l0, x);
     const Lanes new_v[2] = {v[0] + g.kick * ax, v[1] + g.kick * ay};
     const Lanes new_x[2] = {x[0] + g.dt * vx, x[1] + g.dt * vy};
-    store(out.new_deformation_gradient[0] + l0, n00);
-    store(out.new_deformation_gradient[1] + l0, n10);
-    store(out.new_deformation_gradient[2] + l0, n01);
-    store(out.new_deformation_gradient[3] + l0, n11);
-    store(out.new_volume + l0, volume);
-    store(out.new_velocity[0] + l0, new_v[0]);
-    store(out.new_velocity[1] + l0, new_v[1]);
-    store(out.new_position[0] + l0, new_x[0]);
-    store(out.new_position[1] + l0, new_x[1]);
+    if (!in_place) {
+      store(out.new_deformation_gradient[0] + l0, n00);
+      store(out.new_deformation_gradient[1] + l0, n10);
+      store(out.new_deformation_gradient[2] + l0, n01);
+      store(out.new_deformation_gradient[3] + l0, n11);
+      store(out.new_volume + l0, volume);
+      store(out.new_velocity[0] + l0, new_v[0]);
+      store(out.new_velocity[1] + l0, new_v[1]);
+      store(out.new_position[0] + l0, new_x[0]);
+      store(out.new_position[1] + l0, new_x[1]);
+      return;
+    }
     // Straight into the particles' arrays, once every lane's values are read.
-    const GatherLaneTargets& to = g.targets;
     const Lanes new_F[4] = {n00, n10, n01, n11};
     if (to.deformation_gradient) store_interleaved(to.deformation_gradient + 4 * l0, new_F);
     if (to.volume) store(to.volume + l0, volume);

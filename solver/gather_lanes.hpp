@@ -43,11 +43,13 @@ struct GatherLaneParticles {
   const double* reference_volume;
 };
 
-// Where the update goes besides GatherLaneSums' new_* (a batch of eight in
-// place): the particles' own arrays from the batch's first, in their layout
-// (x_p and v_p 2 a lane, F_p 4, V_p 1); a null array is not written. Each
-// lane's values are read before its own are written, so an array may be the
-// one the update reads (x_p, v_p and F_p in place).
+// Where the update goes instead of GatherLaneSums (a batch of eight in
+// place, which then leaves the sums and new_* unwritten: nobody reads them,
+// and their 17 stores a half-batch were wasted): the particles' own arrays
+// from the batch's first, in their layout (x_p and v_p 2 a lane, F_p 4, V_p
+// 1); a null array is not written. Each lane's values are read before its
+// own are written, so an array may be the one the update reads (x_p, v_p
+// and F_p in place).
 struct GatherLaneTargets {
   double* position = nullptr;
   double* velocity = nullptr;

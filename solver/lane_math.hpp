@@ -32,7 +32,8 @@ void lane_log(std::size_t n, const double* x, double* log_x);
 void lane_log(LaneBuild build, std::size_t n, const double* x, double* log_x);
 
 // Each build's own, compiled for its instructions (solver/CMakeLists.txt).
-MPMVV_LANE_KERNEL(void sincos_array(std::size_t n, const double* x, double* sin_x, double* cos_x))
+// sincos_array tells whether any x_k lies past kLaneSinCosLimit or is NaN.
+MPMVV_LANE_KERNEL(void sincos_array(std::size_t n, const double* x, double* sin_x, double* cos_x, bool& any_beyond))
 MPMVV_LANE_KERNEL(void log_array(std::size_t n, const double* x, double* log_x))
 
 }  // namespace mpmvv

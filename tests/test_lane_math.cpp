@@ -120,6 +120,14 @@ TEST(LaneSinCos, BeyondTheLimitTheValuesAreLibms) {
     // And within it the lanes' own: 12.5 is reduced by 4 pi/2.
     EXPECT_LE(ulps(s.back(), std::sin(12.5L)), 1.0);
     EXPECT_LE(ulps(c.back(), std::cos(12.5L)), 1.0);
+    // One such argument alone, in a full vector or among the last few.
+    for (std::size_t at = 0; at < 11; ++at) {
+      std::vector<double> y(11, 0.5), sy(11), cy(11);
+      y[at] = 1e300;
+      mpmvv::lane_sincos(build, y.size(), y.data(), sy.data(), cy.data());
+      EXPECT_EQ(bits(sy[at]), bits(std::sin(1e300))) << "at " << at;
+      EXPECT_EQ(bits(cy[at]), bits(std::cos(1e300))) << "at " << at;
+    }
   }
 }
 

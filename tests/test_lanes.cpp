@@ -96,6 +96,22 @@ std::size_t expect_lanes_equal_evaluate(const Shape& shape, std::size_t n, LaneB
         EXPECT_EQ(bits(lane.gradient[k].x()), bits(scalar.gradient[k].x())) << "particle " << p << " entry " << k;
         EXPECT_EQ(bits(lane.gradient[k].y()), bits(scalar.gradient[k].y())) << "particle " << p << " entry " << k;
       }
+      // The block the transfers by rows take (lane_block_first): every
+      // entry's node in it; none only for sixteen entries or a node held at
+      // the grid's edge (listed twice).
+      const std::ptrdiff_t block = shape.lane_block_first(batch, l);
+      const int side = N == 4 ? 2 : 3, row = shape.grid->nodes_x();
+      if (block >= 0) {
+        for (int k = 0; k < scalar.count; ++k) {
+          const std::ptrdiff_t d = scalar.node[k] - block;
+          EXPECT_TRUE(d >= 0 && d % row < side && d / row < side) << "particle " << p << " entry " << k;
+        }
+      } else {
+        bool repeated = false;
+        for (int k = 0; k < scalar.count; ++k)
+          for (int m = 0; m < k; ++m) repeated |= scalar.node[k] == scalar.node[m];
+        EXPECT_TRUE(repeated || (cpdi && scalar.count == N)) << "particle " << p;
+      }
       if constexpr (cpdi) {
         if (scalar.count < N) {
           // The time-step scan's bound of sum |G| over the entries: the one

@@ -324,6 +324,27 @@ TEST(TransferLanes, EveryBuildGivesTheSameSumsBitForBit) {
       const double* b = &sums.acceleration[0][0];
       for (std::size_t k = 0; k < sizeof(sums) / sizeof(double); ++k)
         ASSERT_EQ(bits(a[k]), bits(b[k])) << "batch " << first << ", value " << k;
+      // In place (grid_to_particles' whole batch): the update written over
+      // the very arrays it reads, in the particles' layout, is new_*.
+      std::vector<double> x(in.position, in.position + 2 * mpmvv::kLanes);
+      std::vector<double> v(in.velocity, in.velocity + 2 * mpmvv::kLanes);
+      std::vector<double> F(in.deformation_gradient, in.deformation_gradient + 4 * mpmvv::kLanes);
+      const mpmvv::GatherLaneParticles own{x.data(), v.data(), F.data(), in.reference_volume};
+      std::vector<double> V(mpmvv::kLanes, 0.0);
+      mpmvv::GatherLaneGrid in_place{motion.data(), row, &own, 1e-3, 1.1e-3};
+      in_place.targets = {x.data(), v.data(), F.data(), V.data()};
+      mpmvv::GatherLaneSums unused;
+      mpmvv::gather_lanes(build, in_place, gather, unused);
+      for (int l = 0; l < mpmvv::kLanes; ++l) {
+        for (int c = 0; c < 2; ++c) {
+          ASSERT_EQ(bits(x[2 * l + c]), bits(expected.new_position[c][l])) << "batch " << first << ", lane " << l;
+          ASSERT_EQ(bits(v[2 * l + c]), bits(expected.new_velocity[c][l])) << "batch " << first << ", lane " << l;
+        }
+        for (int c = 0; c < 4; ++c)
+          ASSERT_EQ(bits(F[4 * l + c]), bits(expected.new_deformation_gradient[c][l]))
+              << "batch " << first << ", lane " << l;
+        ASSERT_EQ(bits(V[l]), bits(expected.new_volume[l])) << "batch " << first << ", lane " << l;
+      }
       std::vector<double> scattered(5 * stride, 0.0);
       pending = scatter;
       mpmvv::scatter_lanes(build, fields, particles, pending, rows_of(scattered));

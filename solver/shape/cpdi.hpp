@@ -323,7 +323,7 @@ struct CpdiShapeT {
     batch.first = first;
     const Vec2 wall_lower = g.wall_lower(), wall_upper = g.wall_upper();
     const CpdiLaneGrid lane_grid{g.origin.x(),   g.origin.y(),   g.h,
-                                 g.cells_x,      g.cells_y,      gradient_scale,
+                                 g.cells_x,      g.cells_y,      g.nodes_x(),    gradient_scale,
                                  weight_skew,    wall_lower.x(), wall_lower.y(),
                                  wall_upper.x(), wall_upper.y(), for_scan};
     if (build) cpdi_lane_stencils(*build, lane_grid, in, batch.out);
@@ -371,9 +371,7 @@ struct CpdiShapeT {
   std::ptrdiff_t lane_block_first(const LaneBatch& batch, int l) const
     requires lanes
   {
-    const CpdiLaneStencils& out = batch.out;
-    if (out.span_i[l] > 1 || out.span_j[l] > 1 || out.i0[l] < 0 || out.j0[l] < 0) return -1;
-    return grid->node(out.i0[l], out.j0[l]);
+    return batch.out.block_first[l];
   }
 
   // The bounds of sum_g |G_gp| the kernel gives with the lanes' entries, the

@@ -76,8 +76,8 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
     const Lanes cy = (y + xi * s10 + eta * s11 - g.origin_y) / g.h;
     cell_i[c] = lane_min(__builtin_convertvector(cx, Ints), last_i);
     cell_j[c] = lane_min(__builtin_convertvector(cy, Ints), last_j);
-    fx[c] = cx - __builtin_convertvector(cell_i[c], Lanes);
-    fy[c] = cy - __builtin_convertvector(cell_j[c], Lanes);
+    fx[c] = cx - to_doubles<Lanes>(cell_i[c]);
+    fy[c] = cy - to_doubles<Lanes>(cell_j[c]);
     hx[c] = 1.0 - fx[c];
     hy[c] = 1.0 - fy[c];
   }
@@ -89,14 +89,17 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
   const Ints span_j = lane_max(lane_max(cell_j[0], cell_j[1]), lane_max(cell_j[2], cell_j[3])) - j0;
   store(out.span_i + l0, span_i);
   store(out.span_j + l0, span_j);
+  const Ints no_node = Ints{} - 1;
+  const Ints block = (span_i <= 1) & (span_j <= 1) & (i0 >= 0) & (j0 >= 0);
+  store(out.block_first + l0, block ? i0 + j0 * g.nodes_x : no_node);
 
   // Corner c's hat factors along x at the nodes i0, i0 + 1, i0 + 2: in its
   // own cell (offset 0 or 1 from i0) 1 - fx and fx, elsewhere 0; the same
   // along y. Their products are evaluate's bilinear weights b_k.
   Lanes along_x[4][3], along_y[4][3];
   for (int c = 0; c < 4; ++c) {
-    const Mask first_x = __builtin_convertvector(cell_i[c] - i0, Lanes) == zero;
-    const Mask first_y = __builtin_convertvector(cell_j[c] - j0, Lanes) == zero;
+    const Mask first_x = to_doubles<Lanes>(cell_i[c] - i0) == zero;
+    const Mask first_y = to_doubles<Lanes>(cell_j[c] - j0) == zero;
     along_x[c][0] = first_x ? hx[c] : zero;
     along_x[c][1] = first_x ? fx[c] : hx[c];
     along_x[c][2] = first_x ? zero : fx[c];
@@ -142,8 +145,8 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
     // factors are 1 - f at its cell's offset from i0 and f at the next.
     Lanes wide_x[4][4], wide_y[4][4];
     for (int c = 0; c < 4; ++c) {
-      const Lanes off_x = __builtin_convertvector(cell_i[c] - i0, Lanes);
-      const Lanes off_y = __builtin_convertvector(cell_j[c] - j0, Lanes);
+      const Lanes off_x = to_doubles<Lanes>(cell_i[c] - i0);
+      const Lanes off_y = to_doubles<Lanes>(cell_j[c] - j0);
       for (int a = 0; a < 4; ++a) {
         wide_x[c][a] = off_x == double(a) ? hx[c] : (off_x == double(a - 1) ? fx[c] : zero);
         wide_y[c][a] = off_y == double(a) ? hy[c] : (off_y == double(a - 1) ? fy[c] : zero);
@@ -160,8 +163,8 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
         }
         wide_bound += octagon_length(gsx, gsy);
       }
-    const Mask within = __builtin_convertvector((span_i <= 2) & (span_j <= 2), Mask);
-    bound = __builtin_convertvector(wide, Mask) ? (within ? wide_bound : -1.0 + zero) : bound;
+    const Mask within = to_mask<Mask>((span_i <= 2) & (span_j <= 2));
+    bound = to_mask<Mask>(wide) ? (within ? wide_bound : -1.0 + zero) : bound;
   }
   store(out.gradient_bound + l0, g.for_scan ? bound : zero - 1.0);
 }

@@ -30,6 +30,7 @@ namespace mpmvv {
 struct CpdiLaneGrid {
   double origin_x, origin_y, h;
   int cells_x, cells_y;        // ghost layers included
+  int nodes_x;                 // GridGeometry::nodes_x, for block_first
   double gradient_scale;       // CpdiShapeT::gradient_scale
   double weight_skew;          // CpdiShapeT::weight_skew
   double wall_lower_x, wall_lower_y, wall_upper_x, wall_upper_y;  // GridGeometry::wall_lower, wall_upper
@@ -88,6 +89,12 @@ struct CpdiLaneStencils {
   alignas(32) int j0[kLanes];
   alignas(32) int span_i[kLanes];
   alignas(32) int span_j[kLanes];
+  // CpdiShapeT::lane_block_first: the node (i0, j0) where the lane's nodes
+  // are a 3 x 3 block (spans of 1 at most, from a node of the grid), else -1;
+  // the transfers by rows look at every lane of every batch, and a test of
+  // four of the arrays above lane by lane cost 25 instructions a lane
+  // (callgrind).
+  alignas(32) int block_first[kLanes];
 };
 
 // With the build the kernels run (lane_build), or with a given one, which

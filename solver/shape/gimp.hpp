@@ -162,7 +162,7 @@ struct GimpShapeT {
     batch.first = first;
     const Vec2 wall_lower = g.wall_lower(), wall_upper = g.wall_upper(), upper = g.upper();
     const GimpLaneGrid lane_grid{g.origin.x(),   g.origin.y(),   g.h,            g.cells_x,      g.cells_y,
-                                 wall_lower.x(), wall_lower.y(), wall_upper.x(), wall_upper.y(), upper.x(),
+                                 g.nodes_x(),    wall_lower.x(), wall_lower.y(), wall_upper.x(), wall_upper.y(), upper.x(),
                                  upper.y()};
     if (build) gimp_lane_stencils(*build, lane_grid, in, batch.out);
     else gimp_lane_stencils(lane_grid, in, batch.out);
@@ -195,10 +195,7 @@ struct GimpShapeT {
   std::ptrdiff_t lane_block_first(const LaneBatch& batch, int l) const
     requires lanes
   {
-    const GimpLaneStencils& out = batch.out;
-    const int i = out.node_i[0][l], j = out.node_j[0][l];
-    if (out.node_i[2][l] != i + 2 || out.node_j[2][l] != j + 2) return -1;
-    return grid->node(i, j);
+    return batch.out.block_first[l];
   }
 
   // No bounds of sum_g |G_gp|: uGIMP's gradients are the grid basis's.

@@ -70,26 +70,31 @@ void GimpKernel::body(const GimpLaneGrid& g, const GimpLaneInput& in, GimpLaneSt
   // floor(xi + 0.5) - 1: truncation, less one where it rounded up.
   auto floor_int = [](const Lanes& v) {
     const Ints t = __builtin_convertvector(v, Ints);
-    return t + __builtin_convertvector(__builtin_convertvector(t, Lanes) > v, Ints);
+    return t + __builtin_convertvector(to_doubles<Lanes>(t) > v, Ints);
   };
   const Ints i0 = floor_int(xi_x + 0.5) - 1, j0 = floor_int(xi_y + 0.5) - 1;
   const Ints last_i = none + g.cells_x, last_j = none + g.cells_y;
   Lanes wx[3], dx[3], wy[3], dy[3];
+  Ints node_i[3], node_j[3];
   for (int a = 0; a < 3; ++a) {
     const Ints i = i0 + a, j = j0 + a;
-    const Mask in_x = __builtin_convertvector((i >= none) & (i <= last_i), Mask);
-    const Mask in_y = __builtin_convertvector((j >= none) & (j <= last_j), Mask);
-    store(out.node_i[a] + l0, lane_min(lane_max(i, none), last_i));
-    store(out.node_j[a] + l0, lane_min(lane_max(j, none), last_j));
-    const Lanes node_x = g.origin_x + __builtin_convertvector(i, Lanes) * g.h;
+    const Mask in_x = to_mask<Mask>((i >= none) & (i <= last_i));
+    const Mask in_y = to_mask<Mask>((j >= none) & (j <= last_j));
+    node_i[a] = lane_min(lane_max(i, none), last_i);
+    node_j[a] = lane_min(lane_max(j, none), last_j);
+    store(out.node_i[a] + l0, node_i[a]);
+    store(out.node_j[a] + l0, node_j[a]);
+    const Lanes node_x = g.origin_x + to_doubles<Lanes>(i) * g.h;
     Lanes w, dw;
     gimp_1d<Lanes, Mask>(x - node_x, g.h, lx, w, dw);
     wx[a] = in_x ? w : zero;
     dx[a] = in_x ? dw : zero;
-    gimp_1d<Lanes, Mask>((xi_y - __builtin_convertvector(j, Lanes)) * g.h, g.h, ly, w, dw);
+    gimp_1d<Lanes, Mask>((xi_y - to_doubles<Lanes>(j)) * g.h, g.h, ly, w, dw);
     wy[a] = in_y ? w : zero;
     dy[a] = in_y ? dw : zero;
   }
+  const Ints block = (node_i[2] == node_i[0] + 2) & (node_j[2] == node_j[0] + 2);
+  store(out.block_first + l0, block ? node_i[0] + node_j[0] * g.nodes_x : none - 1);
   for (int b = 0; b < 3; ++b)
     for (int a = 0; a < 3; ++a) {
       store(out.weight[a + 3 * b] + l0, wx[a] * wy[b]);

@@ -13,6 +13,7 @@ namespace mpmvv {
 struct GimpLaneGrid {
   double origin_x, origin_y, h;
   int cells_x, cells_y;  // ghost layers included
+  int nodes_x;           // GridGeometry::nodes_x, for block_first
   double wall_lower_x, wall_lower_y, wall_upper_x, wall_upper_y;  // GridGeometry::wall_lower, wall_upper
   double upper_x, upper_y;                                        // GridGeometry::upper
 };
@@ -38,6 +39,10 @@ struct GimpLaneStencils {
   alignas(32) int node_i[3][kLanes];
   alignas(32) int node_j[3][kLanes];
   alignas(32) int inside[kLanes];  // GimpShapeT::inside, for the time-step scan's health test
+  // GimpShapeT::lane_block_first: node (node_i[0], node_j[0]) where the three
+  // nodes along each axis follow one another (none held at the grid's edge),
+  // else -1; the transfers by rows look at every lane of every batch.
+  alignas(32) int block_first[kLanes];
 };
 
 // With the build the kernels run (lane_build), or with a given one, which

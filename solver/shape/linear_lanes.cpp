@@ -33,7 +33,7 @@ struct LinearKernel {
     const Ints i = lane_max(lane_min(__builtin_convertvector(xi_x, Ints), none + (g.cells_x - 1)), none);
     const Ints j = lane_max(lane_min(__builtin_convertvector(xi_y, Ints), none + (g.cells_y - 1)), none);
     store(out.first_node + l0, j * g.nodes_x + i);  // GridGeometry::node(i, j)
-    const Lanes fx = xi_x - __builtin_convertvector(i, Lanes), fy = xi_y - __builtin_convertvector(j, Lanes);
+    const Lanes fx = xi_x - to_doubles<Lanes>(i), fy = xi_y - to_doubles<Lanes>(j);
     const Lanes gx = 1.0 - fx, gy = 1.0 - fy;
     const double inv_h = 1.0 / g.h;
     // Slots 0, 1, 3, 4: bilinear_cell's entries 0-3, each stored as it is
