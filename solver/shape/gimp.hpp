@@ -161,9 +161,9 @@ struct GimpShapeT {
     }
     batch.first = first;
     const Vec2 wall_lower = g.wall_lower(), wall_upper = g.wall_upper(), upper = g.upper();
-    const GimpLaneGrid lane_grid{g.origin.x(),   g.origin.y(),   g.h,            g.cells_x,      g.cells_y,
-                                 g.nodes_x(),    wall_lower.x(), wall_lower.y(), wall_upper.x(), wall_upper.y(), upper.x(),
-                                 upper.y()};
+    const GimpLaneGrid lane_grid{g.origin.x(),   g.origin.y(),   g.h,            g.cells_x,
+                                 g.cells_y,      g.nodes_x(),    wall_lower.x(), wall_lower.y(),
+                                 wall_upper.x(), wall_upper.y(), upper.x(),      upper.y()};
     if (build) gimp_lane_stencils(*build, lane_grid, in, batch.out);
     else gimp_lane_stencils(lane_grid, in, batch.out);
   }
