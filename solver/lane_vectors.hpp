@@ -231,6 +231,21 @@ MPMVV_LANE_INLINE Mask to_mask(const Ints& m) {
   return __builtin_convertvector(m, Mask);
 }
 
+// A double comparison's lanes (0 or -1) as ints: the inverse of to_mask,
+// which GCC 12 forms by four shuffles.
+template <class Ints, class Mask>
+MPMVV_LANE_INLINE Ints to_ints(const Mask& m) {
+#if defined(__AVX512F__)
+  if constexpr (sizeof(Mask) == 64) return Ints(_mm512_maskz_cvtepi64_epi32(__mmask8(0xff), __m512i(m)));
+#endif
+#if defined(__AVX2__)
+  if constexpr (sizeof(Mask) == 32)
+    return Ints(_mm256_castsi256_si128(
+        _mm256_permutevar8x32_epi32(__m256i(m), _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6))));
+#endif
+  return __builtin_convertvector(m, Ints);
+}
+
 template <class V>
 MPMVV_LANE_INLINE V lane_min(const V& a, const V& b) {
   return a < b ? a : b;

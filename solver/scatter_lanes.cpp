@@ -60,14 +60,21 @@ void scatter(const ScatterParticles& P, const ScatterLaneBatch& in, const Scatte
         add_row(momentum_y + at, w * py);
       }
       if constexpr (Internal || Body) {
-        // f = 0; f -= (V_p sigma_p) G_gp; f += w (m_p b_p); node.force += f
+        // f = 0; f -= (V_p sigma_p) G_gp; f += w (m_p b_p); node.force += f.
+        // With both terms, w (m_p b_p) - (V_p sigma_p) G_gp: (0 - a) + c is
+        // c - a but for the sign of a zero result, which leaves a sum from +0
+        // as it is (one instruction a row and component less).
         Row fx = {}, fy = {};
         if constexpr (Internal) {
           const Row gx = row_of<Rows>(in.gradient_x, b, l), gy = row_of<Rows>(in.gradient_y, b, l);
-          fx = fx - (sxx * gx + sxy * gy);
-          fy = fy - (syx * gx + syy * gy);
-        }
-        if constexpr (Body) {
+          if constexpr (Body) {
+            fx = w * bx - (sxx * gx + sxy * gy);
+            fy = w * by - (syx * gx + syy * gy);
+          } else {
+            fx = fx - (sxx * gx + sxy * gy);
+            fy = fy - (syx * gx + syy * gy);
+          }
+        } else if constexpr (Body) {
           fx = fx + w * bx;
           fy = fy + w * by;
         }

@@ -62,8 +62,8 @@ void NeoHookeanScanKernel::body(const Grid& g, const In& in, Out& out, int l0) {
     must_form = bound < zero;
   }
   const Mask ruled_out = sound & (room > zero) & (modulus <= density * room * room) & ~must_form;
-  store(out.sound + l0, __builtin_convertvector(sound, Ints));
-  store(out.may_set_speed + l0, __builtin_convertvector(~ruled_out, Ints));
+  store(out.sound + l0, to_ints<Ints>(sound));
+  store(out.may_set_speed + l0, to_ints<Ints>(~ruled_out));
 }
 
 // NeoHookean::stress with F_33 = 1, line by line:

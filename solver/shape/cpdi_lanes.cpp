@@ -58,7 +58,7 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
     const double cells_x = g.cells_x, cells_y = g.cells_y;
     const Mask inside = centre & (low_x >= 0.0) & (low_x <= cells_x) & (low_y >= 0.0) & (low_y <= cells_y) &
                         (high_x >= 0.0) & (high_x <= cells_x) & (high_y >= 0.0) & (high_y <= cells_y);
-    store(out.inside + l0, __builtin_convertvector(inside, Ints));
+    store(out.inside + l0, to_ints<Ints>(inside));
   }
 
   Ints cell_i[4], cell_j[4];

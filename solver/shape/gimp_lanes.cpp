@@ -65,12 +65,12 @@ void GimpKernel::body(const GimpLaneGrid& g, const GimpLaneInput& in, GimpLaneSt
   const Mask inside = (x >= g.wall_lower_x) & (x <= g.wall_upper_x) & (y >= g.wall_lower_y) &
                       (y <= g.wall_upper_y) & (x - lx >= g.origin_x) & (y - ly >= g.origin_y) &
                       (x + lx <= g.upper_x) & (y + ly <= g.upper_y);
-  store(out.inside + l0, __builtin_convertvector(inside, Ints));
+  store(out.inside + l0, to_ints<Ints>(inside));
   const Lanes xi_x = (x - g.origin_x) / g.h, xi_y = (y - g.origin_y) / g.h;  // grid_coordinate
   // floor(xi + 0.5) - 1: truncation, less one where it rounded up.
   auto floor_int = [](const Lanes& v) {
     const Ints t = __builtin_convertvector(v, Ints);
-    return t + __builtin_convertvector(to_doubles<Lanes>(t) > v, Ints);
+    return t + to_ints<Ints>(to_doubles<Lanes>(t) > v);
   };
   const Ints i0 = floor_int(xi_x + 0.5) - 1, j0 = floor_int(xi_y + 0.5) - 1;
   const Ints last_i = none + g.cells_x, last_j = none + g.cells_y;

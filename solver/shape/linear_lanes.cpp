@@ -27,7 +27,7 @@ struct LinearKernel {
     // inside_walls; NaN fails.
     const Mask inside =
         (x[0] >= g.wall_lower_x) & (x[0] <= g.wall_upper_x) & (x[1] >= g.wall_lower_y) & (x[1] <= g.wall_upper_y);
-    store(out.inside + l0, __builtin_convertvector(inside, Ints));
+    store(out.inside + l0, to_ints<Ints>(inside));
     const Lanes xi_x = (x[0] - g.origin_x) / g.h, xi_y = (x[1] - g.origin_y) / g.h;  // grid_coordinate
     // cell_index, and at least 0 so that a lane outside names a node.
     const Ints i = lane_max(lane_min(__builtin_convertvector(xi_x, Ints), none + (g.cells_x - 1)), none);
