@@ -132,10 +132,27 @@ constexpr bool may_scatter_by_rows() {
   return false;
 }
 
+// Every lane's block (lane_block_first) into `first_node`; true where all
+// are blocks. All kLanes lanes, a short batch's spare lanes repeating its
+// first (lanes.hpp: copied_lane_particle), so that the loop has no exit and
+// the compiler vectorises it: lane by lane with an exit it cost 9
+// instructions a lane in each transfer (callgrind).
+template <class Shape, class Node>
+bool lane_blocks(const Shape& shape, const typename Shape::LaneBatch& batch, Node (&first_node)[kLanes]) {
+  Node lowest = 0;
+  for (int l = 0; l < kLanes; ++l) {
+    const Node block = Node(shape.lane_block_first(batch, l));
+    first_node[l] = block;
+    lowest = std::min(lowest, block);
+  }
+  return lowest >= 0;
+}
+
 // Whether a map adds by rows, decided once a map: always for a shape whose
 // stencils are blocks but at the grid's edge (uGIMP: a domain of at most a
-// cell's width; linear: the cell's 2 x 2 nodes; lane_blocks_only); for one whose domains may stretch past a
-// cell (CPDI: most of them from t = 0.3 s of the ring at A = 1), where the
+// cell's width; linear: the cell's 2 x 2 nodes; lane_blocks_only); for one
+// whose domains may stretch past a cell (CPDI: most of them from t = 0.3 s
+// of the ring at A = 1), where the
 // last map found at least kRowsFromBlockShare of its batches all blocks. A
 // batch that is not goes entry by entry into the sums field by field, which
 // costs more than node by node (ScatterSums). Measured for CPDI (callgrind,
@@ -426,13 +443,7 @@ void map_to_grid(const Shape& shape, const Particles& P, ScatterBuffers& buffers
           // few are blocks, callgrind); by rows every batch is looked at anyway.
           if constexpr (counts_blocks) {
             if (by_rows || seen_batches++ % kBlockSample == 0) {
-              // (the first lane that is no block settles it)
-              bool blocks = true;
-              for (int l = 0; l < count && blocks; ++l) {
-                const std::ptrdiff_t block = shape.lane_block_first(batch, l);
-                blocks = block >= 0;
-                if constexpr (by_rows) rows.first_node[l] = block;
-              }
+              const bool blocks = lane_blocks(shape, batch, rows.first_node);
               ++own_batches;
               own_block_batches += blocks;
               if constexpr (by_rows) batch_by_rows = blocks;
@@ -593,10 +604,10 @@ enum ParticleUpdate : unsigned {
 // (each particle reads its own position before writing it) or, when a later
 // stage still needs the old positions, another array.
 //
-// A shape whose lane kernel leaves blocks of nodes (3 x 3; linear's 2 x 2) takes its sums by
-// lanes (gather_lanes.hpp) from the nodes' a_g and v_g^L packed side by side
-// into `motion` (a scratch the caller keeps between steps; one of its own
-// without).
+// A shape whose lane kernel leaves blocks of nodes (3 x 3; linear's 2 x 2)
+// takes its sums by lanes (gather_lanes.hpp) from the nodes' a_g and v_g^L
+// packed side by side into `motion` (a scratch the caller keeps between
+// steps; one of its own without).
 template <unsigned Updates, class Shape>
 void grid_to_particles(const Shape& shape, const GridFields& g, Particles& P, double dt, double kick,
                        Vec2* position_out = nullptr, ParticleRange range = {}, std::vector<double>* motion = nullptr) {
@@ -709,11 +720,7 @@ void grid_to_particles(const Shape& shape, const GridFields& g, Particles& P, do
     auto whole_batch = [&](std::size_t first, int count, const double*, auto&& batch) {
       if constexpr (by_rows) {
         batch_by_rows = false;
-        for (int k = 0; k < kLanes; ++k) {
-          const std::ptrdiff_t block = shape.lane_block_first(batch, k);
-          if (block < 0) return false;  // entry by entry, the whole batch
-          lane_batch.first_node[k] = block;
-        }
+        if (!lane_blocks(shape, batch, lane_batch.first_node)) return false;  // entry by entry, the whole batch
         take_slots(batch, lane_batch);
         batch_by_rows = true;
         if constexpr (with_affine) {  // the sums by lanes, each particle then visited
@@ -904,7 +911,8 @@ void update_stress(const Material& material, Particles& P, std::size_t begin = 0
 // the hoop stress takes the same -q.
 // The length l_p is the particle's own thinnest width, the area of the
 // method's domain (shape.domain, as the monitors read it) over its longest
-// side (at most the cell size h; h for a method without one, linear and B-spline MPM). Eq. 1.66 suggests h; but a viscous stress is stable only to a
+// side (at most the cell size h; h for a method without one, linear and
+// B-spline MPM). Eq. 1.66 suggests h; but a viscous stress is stable only to a
 // step that shrinks with the square of the width its gradients act across,
 // and a sheared CPDI domain grows thin: with l = h the ring at A = 1 on 256
 // cells, which completes without viscosity, stopped with nan at t = 0.315 s
@@ -1151,7 +1159,8 @@ double signal_speed(const Shape& shape, const Material& material, const Particle
     const double room = largest * (1.0 - 1e-9) - v;
     if (room > 0.0) {
       double modulus = material.wave_modulus_bound(P.deformation_gradient[p], F33, P.stress[p]);
-      if constexpr (Shape::gradients_beyond_grid_basis) modulus = std::max(modulus, most * most * material.p_wave_modulus());
+      if constexpr (Shape::gradients_beyond_grid_basis)
+        modulus = std::max(modulus, most * most * material.p_wave_modulus());
       if (modulus <= density * room * room) return 0.0;
     }
   }
