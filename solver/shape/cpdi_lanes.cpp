@@ -46,7 +46,10 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
   // s^-T = [[s11, -s10], [-s01, s00]] / det s (corner_gradients).
   const Lanes inv_det = g.gradient_scale / (s00 * s11 - s01 * s10);
   const Ints last_i = Ints{} + (g.cells_x - 1), last_j = Ints{} + (g.cells_y - 1);
-  if (g.for_scan) {
+  // (a local: read from g it was loaded again after every store to out,
+  // which the compiler cannot tell apart from g)
+  const bool for_scan = g.for_scan;
+  if (for_scan) {
     // CpdiShapeT::inside: the centre between the walls (inside_walls) and
     // the corners' bounding box in grid coordinates in [0, cells] along both
     // axes (inside_cells); NaN fails.
@@ -121,7 +124,7 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
       store(out.weight[a + 3 * b] + l0, w);
       store(out.gradient_x[a + 3 * b] + l0, gsx);
       store(out.gradient_y[a + 3 * b] + l0, gsy);
-      if (g.for_scan) bound += octagon_length(gsx, gsy);
+      if (for_scan) bound += octagon_length(gsx, gsy);
     }
   const Ints wide = (span_i > 1) | (span_j > 1);
   bool any_wide = false;
@@ -140,7 +143,7 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
       store(out.corner_j[c] + l0, cell_j[c]);
     }
   }
-  if (any_wide && g.for_scan) {
+  if (any_wide && for_scan) {
     // The bound over the 4 x 4 nodes from (i0, j0), as above: corner c's hat
     // factors are 1 - f at its cell's offset from i0 and f at the next.
     Lanes wide_x[4][4], wide_y[4][4];
@@ -166,7 +169,7 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
     const Mask within = to_mask<Mask>((span_i <= 2) & (span_j <= 2));
     bound = to_mask<Mask>(wide) ? (within ? wide_bound : -1.0 + zero) : bound;
   }
-  store(out.gradient_bound + l0, g.for_scan ? bound : zero - 1.0);
+  store(out.gradient_bound + l0, for_scan ? bound : zero - 1.0);
 }
 
 }  // namespace
