@@ -24,12 +24,19 @@ namespace mpmvv {
 
 // The batch's stencils (S_gp and G_gp by slot and lane) and each lane's
 // block, from its first node; a lane that does not go by rows names any
-// node of the grid (its sums are not read).
+// node of the grid (its sums are not read). A lane at kByCorners (lanes.hpp:
+// a CPDI domain stretched past a cell) sums its sixteen entries by itself,
+// corner c's slots 4 c + a + 2 b of the corner_* arrays at node
+// corner_first[c][l] + a + b row, in the scalar update's order.
 struct GatherLaneBatch {
   const double (*weight)[kLanes];
   const double (*gradient_x)[kLanes];
   const double (*gradient_y)[kLanes];
   int block = 3;  // nodes along a block's side: 3 (CPDI, uGIMP) or 2 (linear: slots 0, 1, 3, 4)
+  const double (*corner_weight)[kLanes] = nullptr;  // CPDI's wide entries (cpdi_lanes.hpp)
+  const double (*corner_gradient_x)[kLanes] = nullptr;
+  const double (*corner_gradient_y)[kLanes] = nullptr;
+  const int (*corner_first)[kLanes] = nullptr;
   alignas(32) long long first_node[kLanes];
 };
 

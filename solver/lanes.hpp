@@ -15,6 +15,14 @@ namespace mpmvv {
 
 inline constexpr int kLanes = 8;
 
+// A lane's nodes for the transfers by rows (scatter_lanes.hpp,
+// gather_lanes.hpp), as a shape's lane_block_first gives them: the first
+// node of its block where they are one (3 x 3; linear's 2 x 2), else one of
+// these.
+inline constexpr int kNoBlock = -1;    // none: the lane goes entry by entry
+inline constexpr int kByCorners = -2;  // CPDI's sixteen entries (a domain stretched past a cell): four
+                                       // blocks of 2 x 2 nodes, one per corner's cell (corner_first)
+
 // The particle lane l holds where a batch of `count` particles from `first`
 // is copied into lanes (a batch of fewer than kLanes, or one that cannot be
 // read in place): its own, and the first's in the spare lanes, so that they

@@ -49,7 +49,10 @@ void scatter(const ScatterParticles& P, const ScatterLaneBatch& in, const Scatte
   const double(*const weight)[kLanes] = in.weight;
   const double(*const gradient_x)[kLanes] = in.gradient_x;
   const double(*const gradient_y)[kLanes] = in.gradient_y;
-  using Row = RowOf<Rows>;
+  const double(*const corner_weight)[kLanes] = in.corner_weight;
+  const double(*const corner_gradient_x)[kLanes] = in.corner_gradient_x;
+  const double(*const corner_gradient_y)[kLanes] = in.corner_gradient_y;
+  const int(*const corner_first)[kLanes] = in.corner_first;
   for (int l = 0; l < kLanes; ++l) {
     if (!((in.pending >> l) & 1u)) continue;
     const std::size_t p = in.first + std::size_t(l);
@@ -63,10 +66,9 @@ void scatter(const ScatterParticles& P, const ScatterLaneBatch& in, const Scatte
       sxy = V * stress[4 * p + 2], syy = V * stress[4 * p + 3];
     }
     if constexpr (Body) bx = m * body_force[2 * p], by = m * body_force[2 * p + 1];
-    const std::ptrdiff_t first_node = in.first_node[l];
-    for (int b = 0; b < Rows; ++b) {
-      const std::ptrdiff_t at = first_node + b * row;
-      const Row w = row_of<Rows>(weight, b, l);
+    // A row of nodes from `at`, its weights w and its gradients' rows from
+    // gradients() (read only where the internal force asks for them).
+    auto add = [&]<class Row>(std::ptrdiff_t at, const Row& w, auto gradients) __attribute__((always_inline)) {
       if constexpr (Mass) add_row(mass + at, w * m);  // node.mass += w * m
       if constexpr (Momentum) {
         add_row(momentum_x + at, w * px);
@@ -79,7 +81,8 @@ void scatter(const ScatterParticles& P, const ScatterLaneBatch& in, const Scatte
         // as it is (one instruction a row and component less).
         Row fx = {}, fy = {};
         if constexpr (Internal) {
-          const Row gx = row_of<Rows>(gradient_x, b, l), gy = row_of<Rows>(gradient_y, b, l);
+          Row gx, gy;
+          gradients(gx, gy);
           if constexpr (Body) {
             fx = w * bx - (sxx * gx + sxy * gy);
             fy = w * by - (syx * gx + syy * gy);
@@ -94,6 +97,27 @@ void scatter(const ScatterParticles& P, const ScatterLaneBatch& in, const Scatte
         add_row(force_x + at, fx);
         add_row(force_y + at, fy);
       }
+    };
+    const std::ptrdiff_t first_node = in.first_node[l];
+    if (Rows == 2 || first_node != kByCorners) {
+      for (int b = 0; b < Rows; ++b)
+        add(first_node + b * row, row_of<Rows>(weight, b, l), [&](RowOf<Rows>& gx, RowOf<Rows>& gy) {
+          gx = row_of<Rows>(gradient_x, b, l);
+          gy = row_of<Rows>(gradient_y, b, l);
+        });
+    } else {
+      // Corner by corner, each its cell's two rows of two nodes: slots
+      // 4 c + 2 b and 4 c + 2 b + 1.
+      using Pair = RowOf<2>;
+      for (int c = 0; c < 4; ++c)
+        for (int b = 0; b < 2; ++b) {
+          const int s = 4 * c + 2 * b;
+          add(corner_first[c][l] + b * row, Pair{corner_weight[s][l], corner_weight[s + 1][l]},
+              [&](Pair& gx, Pair& gy) {
+                gx = Pair{corner_gradient_x[s][l], corner_gradient_x[s + 1][l]};
+                gy = Pair{corner_gradient_y[s][l], corner_gradient_y[s + 1][l]};
+              });
+        }
     }
   }
 }

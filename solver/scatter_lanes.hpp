@@ -2,7 +2,11 @@
 // 002_c3305cb8b1bc1490.txt) for a batch of particles whose stencils a lane
 // kernel left as 3 x 3 blocks of nodes (shape/cpdi_lanes.hpp,
 // shape/gimp_lanes.hpp), or 2 x 2 (shape/linear_lanes.hpp, in the same
-// layout): slot a + 3 b at node first + a + b row.
+// layout): slot a + 3 b at node first + a + b row. A CPDI domain stretched
+// past a cell lists four entries per corner (kByCorners, lanes.hpp): a
+// 2 x 2 block at each corner's cell, added corner by corner as the scalar
+// map adds its entries, so that a node its corners share takes their terms
+// one at a time in the same order.
 //
 // Why: the nodes of a block's row lie side by side in each of the thread's
 // sum arrays, so a particle adds to a row's three nodes with one vector per
@@ -51,12 +55,18 @@ struct ScatterParticles {
 
 // The batch: particle first + l is added where bit l of `pending` is set,
 // at the block from node first_node[l], with its stencil's slots in
-// weight[slot][l], gradient_x[slot][l], gradient_y[slot][l].
+// weight[slot][l], gradient_x[slot][l], gradient_y[slot][l]; where
+// first_node[l] is kByCorners, at corner c's block from corner_first[c][l]
+// with slots 4 c + a + 2 b of the corner_* arrays.
 struct ScatterLaneBatch {
   const double (*weight)[kLanes];
   const double (*gradient_x)[kLanes];
   const double (*gradient_y)[kLanes];
   int block = 3;  // nodes along a block's side: 3 (CPDI, uGIMP) or 2 (linear: slots 0, 1, 3, 4)
+  const double (*corner_weight)[kLanes] = nullptr;  // CPDI's wide entries (cpdi_lanes.hpp)
+  const double (*corner_gradient_x)[kLanes] = nullptr;
+  const double (*corner_gradient_y)[kLanes] = nullptr;
+  const int (*corner_first)[kLanes] = nullptr;
   std::size_t first = 0;
   unsigned pending = 0;
   std::ptrdiff_t first_node[kLanes];

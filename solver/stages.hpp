@@ -132,35 +132,39 @@ constexpr bool may_scatter_by_rows() {
   return false;
 }
 
-// Every lane's block (lane_block_first) into `first_node`; true where all
-// are blocks. All kLanes lanes, a short batch's spare lanes repeating its
-// first (lanes.hpp: copied_lane_particle), in a loop without an exit: the
-// map's loop that stopped at the first lane with no block cost 9
-// instructions a lane (callgrind; 4.8 a particle-step less with this one).
+// Every lane's block (lane_block_first) into `first_node`; true where every
+// lane goes by rows (none is kNoBlock: lanes.hpp). All kLanes lanes, a short
+// batch's spare lanes repeating its first (lanes.hpp: copied_lane_particle),
+// in a loop without an exit: the map's loop that stopped at the first lane
+// with no block cost 9 instructions a lane (callgrind; 4.8 a particle-step
+// less with this one).
 template <class Shape, class Node>
 bool lane_blocks(const Shape& shape, const typename Shape::LaneBatch& batch, Node (&first_node)[kLanes]) {
-  Node lowest = 0;
+  bool all = true;
   for (int l = 0; l < kLanes; ++l) {
     const Node block = Node(shape.lane_block_first(batch, l));
     first_node[l] = block;
-    lowest = std::min(lowest, block);
+    all &= block != kNoBlock;
   }
-  return lowest >= 0;
+  return all;
 }
 
 // Whether a map adds by rows, decided once a map: always for a shape whose
 // stencils are blocks but at the grid's edge (uGIMP: a domain of at most a
-// cell's width; linear: the cell's 2 x 2 nodes; lane_blocks_only); for one
-// whose domains may stretch past a cell (CPDI: most of them from t = 0.3 s
-// of the ring at A = 1), where the last map found at least
-// kRowsFromBlockShare of its batches all blocks. A
-// batch that is not goes entry by entry into the sums field by field, which
-// costs more than node by node (ScatterSums). Measured for CPDI (callgrind,
-// instructions a particle-step of a whole step, by rows against node by
-// node): 256 cells at A = 0.5, t = 0.02-0.04 s (every batch blocks) 1,104
-// against 1,162; 128 cells at A = 0.5, t = 0.40-0.44 s, 1,758 against 1,675;
-// at A = 1, t = 0.40-0.44 s, 2,286 against 2,132. Both layouts add the same
-// terms in the same order: the choice never changes a bit.
+// cell's width; linear: the cell's 2 x 2 nodes; lane_blocks_only); for CPDI,
+// where the last map found at least kRowsFromBlockShare of its batches all
+// by rows. A batch that is not goes entry by entry into the sums field by
+// field, which costs more than node by node (ScatterSums). Measured for CPDI
+// (callgrind, instructions a particle-step of a whole step, by rows against
+// node by node) while a domain stretched past a cell went entry by entry:
+// 256 cells at A = 0.5, t = 0.02-0.04 s (every batch blocks) 1,104 against
+// 1,162; 128 cells at A = 0.5, t = 0.40-0.44 s, 1,758 against 1,675; at A =
+// 1, t = 0.40-0.44 s, 2,286 against 2,132. Such a domain now goes by rows
+// too, by its corners' blocks (kByCorners), which leaves only a stencil
+// that starts off the grid (its particle fails `inside`) out: on 256 cells
+// at A = 0.5, t = 0.40-0.42 s, 1,387 instructions a particle-step by rows
+// against 1,664 before. Both layouts add the same terms in the same order:
+// the choice never changes a bit.
 inline constexpr double kRowsFromBlockShare = 0.9;
 inline constexpr std::size_t kBlockSample = 8;
 template <class Shape>
@@ -230,6 +234,13 @@ void take_slots(const Batch& batch, Rows& rows) {
   // Nodes along a block's side: linear's 2 (LinearLaneStencils::kBlock), else 3.
   if constexpr (requires { decltype(batch.out)::kBlock; }) rows.block = decltype(batch.out)::kBlock;
   else rows.block = 3;
+  // CPDI's wide lanes (kByCorners): their corners' entries.
+  if constexpr (requires { batch.out.corner_first; }) {
+    rows.corner_weight = batch.out.wide_weight;
+    rows.corner_gradient_x = batch.out.wide_gradient_x;
+    rows.corner_gradient_y = batch.out.wide_gradient_y;
+    rows.corner_first = batch.out.corner_first;
+  }
 }
 
 template <class Shape>
@@ -713,10 +724,10 @@ void grid_to_particles(const Shape& shape, const GridFields& g, Particles& P, do
       }
       if constexpr (with_position) position_out[p] = P.position[p] + dt * velocity;
     };
-    // A batch whose every lane goes by rows is updated by lanes whole (no
-    // affine field), without a visit of each of its particles; a batch with
-    // a stretched CPDI domain goes entry by entry whole, which costs less
-    // than sorting it (callgrind, A = 1).
+    // A batch whose every lane goes by rows (a CPDI domain stretched past a
+    // cell by its corners' blocks) is updated by lanes whole (no affine
+    // field), without a visit of each of its particles; a batch with a
+    // stencil off the grid goes entry by entry whole.
     auto whole_batch = [&](std::size_t first, int count, const double*, auto&& batch) {
       if constexpr (by_rows) {
         batch_by_rows = false;

@@ -68,7 +68,7 @@ template <class Shape>
 std::size_t expect_lanes_equal_evaluate(const Shape& shape, std::size_t n, LaneBuild build, bool every_kind = true) {
   constexpr bool cpdi = Shape::gradients_beyond_grid_basis;
   constexpr int N = Shape::stencil_size;
-  std::size_t compared = 0, wide = 0, wide_bounded = 0, outside = 0;
+  std::size_t compared = 0, wide = 0, wide_bounded = 0, outside = 0, by_corners = 0;
   for (std::size_t first = 0; first < n; first += mpmvv::kLanes) {
     const int count = int(std::min<std::size_t>(mpmvv::kLanes, n - first));
     typename Shape::LaneBatch batch;
@@ -97,8 +97,9 @@ std::size_t expect_lanes_equal_evaluate(const Shape& shape, std::size_t n, LaneB
         EXPECT_EQ(bits(lane.gradient[k].y()), bits(scalar.gradient[k].y())) << "particle " << p << " entry " << k;
       }
       // The block the transfers by rows take (lane_block_first): every
-      // entry's node in it; none only for sixteen entries or a node held at
-      // the grid's edge (listed twice).
+      // entry's node in it; CPDI's sixteen entries by corners, entry 4 c + k
+      // the k-th node of corner c's cell from corner_first; none only for a
+      // node held at the grid's edge (listed twice).
       const std::ptrdiff_t block = shape.lane_block_first(batch, l);
       const int side = N == 4 ? 2 : 3, row = shape.grid->nodes_x();
       if (block >= 0) {
@@ -106,7 +107,16 @@ std::size_t expect_lanes_equal_evaluate(const Shape& shape, std::size_t n, LaneB
           const std::ptrdiff_t d = scalar.node[k] - block;
           EXPECT_TRUE(d >= 0 && d % row < side && d / row < side) << "particle " << p << " entry " << k;
         }
+      } else if (block == mpmvv::kByCorners) {
+        EXPECT_TRUE(cpdi && scalar.count == N) << "particle " << p;
+        if constexpr (cpdi) {
+          ++by_corners;
+          for (int k = 0; k < scalar.count; ++k)
+            EXPECT_EQ(scalar.node[k], batch.out.corner_first[k / 4][l] + (k % 2) + (k % 4 / 2) * row)
+                << "particle " << p << " entry " << k;
+        }
       } else {
+        EXPECT_EQ(block, mpmvv::kNoBlock) << "particle " << p;
         bool repeated = false;
         for (int k = 0; k < scalar.count; ++k)
           for (int m = 0; m < k; ++m) repeated |= scalar.node[k] == scalar.node[m];
@@ -148,6 +158,7 @@ std::size_t expect_lanes_equal_evaluate(const Shape& shape, std::size_t n, LaneB
     EXPECT_GT(outside, 0u);
     EXPECT_GT(wide_bounded, 0u);
     EXPECT_GT(compared - wide, n / 4);
+    EXPECT_EQ(by_corners, wide);  // every wide stencil inside the grid goes by its corners
   }
   return wide - wide_bounded;
 }

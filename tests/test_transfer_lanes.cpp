@@ -3,7 +3,7 @@
 // sums and the time-step scan's verdict (by rows for uGIMP and linear; CPDI's lanes
 // there add entry by entry, against its scalar stencils), and grid-to-particle's x_p, v_p,
 // F_p, V_p and APIC's C_p, over CPDI domains merged and stretched past a
-// cell, uGIMP at the grid's edge, a batch of fewer than eight, and particles
+// cell (by their corners' blocks), uGIMP at the grid's edge, a batch of fewer than eight, and particles
 // the scan leaves out; each build of the kernels this CPU can run; and a
 // map into buffers that earlier maps used.
 #include <gtest/gtest.h>
@@ -286,7 +286,7 @@ TEST(TransferLanes, EveryBuildGivesTheSameSumsBitForBit) {
   const mpmvv::ScatterParticles particles{P.mass.data(), mpmvv::values_of(P.velocity.data()), P.volume.data(),
                                           mpmvv::values_of(P.stress.data()), mpmvv::values_of(P.body_force.data())};
   const mpmvv::ScatterFields fields{true, true, true, true};
-  std::size_t by_rows = 0;
+  std::size_t by_rows = 0, by_corners = 0;
   for (std::size_t first = 0; first + mpmvv::kLanes <= P.size(); first += mpmvv::kLanes) {
     CpdiShape::LaneBatch batch;
     shape.compute_lanes(first, mpmvv::kLanes, batch, false);
@@ -297,9 +297,10 @@ TEST(TransferLanes, EveryBuildGivesTheSameSumsBitForBit) {
     scatter.first = first;
     for (int l = 0; l < mpmvv::kLanes; ++l) {
       const std::ptrdiff_t block = shape.lane_block_first(batch, l);
-      gather.first_node[l] = std::max<std::ptrdiff_t>(block, 0);
+      gather.first_node[l] = block == mpmvv::kNoBlock ? 0 : block;
       scatter.first_node[l] = block;
-      if (block >= 0) scatter.pending |= 1u << l, ++by_rows;
+      if (block != mpmvv::kNoBlock) scatter.pending |= 1u << l, ++by_rows;
+      by_corners += block == mpmvv::kByCorners;
     }
     const mpmvv::GatherLaneParticles in{mpmvv::values_of(P.position.data() + first),
                                         mpmvv::values_of(P.velocity.data() + first),
@@ -353,6 +354,7 @@ TEST(TransferLanes, EveryBuildGivesTheSameSumsBitForBit) {
     }
   }
   EXPECT_GT(by_rows, P.size() / 2);
+  EXPECT_GT(by_corners, 0u);  // domains stretched past a cell among them
 }
 
 }  // namespace

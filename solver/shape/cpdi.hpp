@@ -347,7 +347,7 @@ struct CpdiShapeT {
     const int row = grid->nodes_x();
     if (out.span_i[l] > 1 || out.span_j[l] > 1) {  // four entries per corner
       for (int c = 0; c < 4; ++c) {
-        const int n00 = grid->node(out.corner_i[c][l], out.corner_j[c][l]);
+        const int n00 = out.corner_first[c][l];
         const int nodes[4] = {n00, n00 + 1, n00 + row, n00 + row + 1};
         for (int k = 0; k < 4; ++k) {
           const int slot = 4 * c + k;
@@ -365,9 +365,10 @@ struct CpdiShapeT {
   }
 
   // Where lane l's entries form a 3 x 3 block of nodes, slot a + 3 b at
-  // node first + a + b nodes_x (scatter_lanes.hpp), its first node; -1 for
-  // a wide lane (or a block that starts off the grid: its particle fails
-  // inside). A stencil of two columns or rows has zeros in the third.
+  // node first + a + b nodes_x (scatter_lanes.hpp), its first node; for a
+  // wide lane kByCorners (lanes.hpp: the blocks of its corners' cells), and
+  // kNoBlock for nodes that start off the grid (its particle fails inside).
+  // A stencil of two columns or rows has zeros in the third.
   std::ptrdiff_t lane_block_first(const LaneBatch& batch, int l) const
     requires lanes
   {

@@ -92,9 +92,9 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
   const Ints span_j = lane_max(lane_max(cell_j[0], cell_j[1]), lane_max(cell_j[2], cell_j[3])) - j0;
   store(out.span_i + l0, span_i);
   store(out.span_j + l0, span_j);
-  const Ints no_node = Ints{} - 1;
-  const Ints block = (span_i <= 1) & (span_j <= 1) & (i0 >= 0) & (j0 >= 0);
-  store(out.block_first + l0, block ? i0 + j0 * g.nodes_x : no_node);
+  const Ints narrow = (span_i <= 1) & (span_j <= 1);
+  const Ints by_corners = Ints{} + kByCorners, no_block = Ints{} + kNoBlock;
+  store(out.block_first + l0, (i0 >= 0) & (j0 >= 0) ? (narrow ? i0 + j0 * g.nodes_x : by_corners) : no_block);
 
   // Corner c's hat factors along x at the nodes i0, i0 + 1, i0 + 2: in its
   // own cell (offset 0 or 1 from i0) 1 - fx and fx, elsewhere 0; the same
@@ -126,7 +126,7 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
       store(out.gradient_y[a + 3 * b] + l0, gsy);
       if (for_scan) bound += octagon_length(gsx, gsy);
     }
-  const Ints wide = (span_i > 1) | (span_j > 1);
+  const Ints wide = ~narrow;
   bool any_wide = false;
   for (int l = 0; l < W; ++l) any_wide |= wide[l] != 0;
   if (any_wide) {
@@ -139,8 +139,7 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
         store(out.wide_gradient_x[4 * c + k] + l0, grad_x[c] * b[k]);
         store(out.wide_gradient_y[4 * c + k] + l0, grad_y[c] * b[k]);
       }
-      store(out.corner_i[c] + l0, cell_i[c]);
-      store(out.corner_j[c] + l0, cell_j[c]);
+      store(out.corner_first[c] + l0, cell_i[c] + cell_j[c] * g.nodes_x);  // GridGeometry::node
     }
   }
   if (any_wide && for_scan) {

@@ -19,7 +19,8 @@
 // kernel's own `inside` before it lists the stencil.
 //
 // A lane whose corners span more than 2 x 2 cells (a domain stretched past a
-// cell) takes evaluate's other form: four entries per corner, not merged.
+// cell) takes evaluate's other form: four entries per corner, not merged,
+// which the transfers by rows take as four blocks of 2 x 2 nodes.
 #pragma once
 
 #include "../lanes.hpp"
@@ -65,7 +66,7 @@ struct CpdiLaneCopy {
 //
 // A lane with a span over 1 is `wide`: its entries are evaluate's sixteen,
 // corner c's in slots 4 c + k, at the nodes (i, j), (i + 1, j), (i, j + 1),
-// (i + 1, j + 1) of the corner's cell (corner_i, corner_j), and its
+// (i + 1, j + 1) of the corner's cell, node (i, j) in corner_first, and its
 // gradient_bound is the octagon bound over the nodes they reach, each node's
 // entries summed in the order merged_gradients sums them (stencil.hpp), so
 // it bounds the scan's stiffening (stages.hpp: gradient_sum) and not the
@@ -79,8 +80,7 @@ struct CpdiLaneStencils {
   alignas(64) double wide_weight[16][kLanes];
   alignas(64) double wide_gradient_x[16][kLanes];
   alignas(64) double wide_gradient_y[16][kLanes];
-  alignas(32) int corner_i[4][kLanes];
-  alignas(32) int corner_j[4][kLanes];
+  alignas(32) int corner_first[4][kLanes];  // GridGeometry::node of the corner's cell's first node
   // CpdiShapeT::inside: the centre lies between the walls and the domain's
   // bounding box, x_p -+ (|r_1| + |r_2|) along each axis, in the grid's
   // cells; only where CpdiLaneGrid::for_scan asks for it.
@@ -90,10 +90,11 @@ struct CpdiLaneStencils {
   alignas(32) int span_i[kLanes];
   alignas(32) int span_j[kLanes];
   // CpdiShapeT::lane_block_first: the node (i0, j0) where the lane's nodes
-  // are a 3 x 3 block (spans of 1 at most, from a node of the grid), else -1;
-  // the transfers by rows look at every lane of every batch, and a test of
-  // four of the arrays above lane by lane cost 25 instructions a lane
-  // (callgrind).
+  // are a 3 x 3 block (spans of 1 at most), kByCorners for a wide lane
+  // (lanes.hpp), and kNoBlock where a corner's cell is off the grid (i0 or
+  // j0 negative: the particle fails `inside`); the transfers by rows look at
+  // every lane of every batch, and a test of four of the arrays above lane
+  // by lane cost 25 instructions a lane (callgrind).
   alignas(32) int block_first[kLanes];
 };
 
