@@ -143,30 +143,50 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
     }
   }
   if (any_wide && for_scan) {
-    // The bound over the 4 x 4 nodes from (i0, j0), as above: corner c's hat
-    // factors are 1 - f at its cell's offset from i0 and f at the next.
-    Lanes wide_x[4][4], wide_y[4][4];
-    for (int c = 0; c < 4; ++c) {
-      const Lanes off_x = to_doubles<Lanes>(cell_i[c] - i0);
-      const Lanes off_y = to_doubles<Lanes>(cell_j[c] - j0);
-      for (int a = 0; a < 4; ++a) {
-        wide_x[c][a] = off_x == double(a) ? hx[c] : (off_x == double(a - 1) ? fx[c] : zero);
-        wide_y[c][a] = off_y == double(a) ? hy[c] : (off_y == double(a - 1) ? fy[c] : zero);
-      }
+    const Ints within = (span_i <= 2) & (span_j <= 2);
+    const Ints wide_within = wide & within, beyond = wide & ~within;
+    bool any_within = false, any_beyond = false;
+    for (int l = 0; l < W; ++l) {
+      any_within |= wide_within[l] != 0;
+      any_beyond |= beyond[l] != 0;
     }
     Lanes wide_bound = zero;
-    for (int b = 0; b < 4; ++b)
-      for (int a = 0; a < 4; ++a) {
-        Lanes gsx = zero, gsy = zero;
-        for (int c = 0; c < 4; ++c) {
-          const Lanes share = wide_x[c][a] * wide_y[c][b];
-          gsx += grad_x[c] * share;
-          gsy += grad_y[c] * share;
+    if (any_within) {
+      // The bound over the 4 x 4 nodes from (i0, j0), as above: corner c's
+      // hat factors are 1 - f at its cell's offset from i0 and f at the next.
+      Lanes wide_x[4][4], wide_y[4][4];
+      for (int c = 0; c < 4; ++c) {
+        const Lanes off_x = to_doubles<Lanes>(cell_i[c] - i0);
+        const Lanes off_y = to_doubles<Lanes>(cell_j[c] - j0);
+        for (int a = 0; a < 4; ++a) {
+          wide_x[c][a] = off_x == double(a) ? hx[c] : (off_x == double(a - 1) ? fx[c] : zero);
+          wide_y[c][a] = off_y == double(a) ? hy[c] : (off_y == double(a - 1) ? fy[c] : zero);
         }
-        wide_bound += octagon_length(gsx, gsy);
       }
-    const Mask within = to_mask<Mask>((span_i <= 2) & (span_j <= 2));
-    bound = to_mask<Mask>(wide) ? (within ? wide_bound : -1.0 + zero) : bound;
+      for (int b = 0; b < 4; ++b)
+        for (int a = 0; a < 4; ++a) {
+          Lanes gsx = zero, gsy = zero;
+          for (int c = 0; c < 4; ++c) {
+            const Lanes share = wide_x[c][a] * wide_y[c][b];
+            gsx += grad_x[c] * share;
+            gsy += grad_y[c] * share;
+          }
+          wide_bound += octagon_length(gsx, gsy);
+        }
+    }
+    Lanes entry_bound = zero;
+    if (any_beyond) {
+      // Corners past 4 x 4 nodes: the bound over the sixteen entries as
+      // listed (stencil.hpp: entry_gradient_sum_bound, the same sum in the
+      // same order), which the scan would otherwise form from the listed
+      // stencil (callgrind, A = 1, t = 0.40-0.42 s: 78 instructions a
+      // particle-step, besides the listing).
+      for (int c = 0; c < 4; ++c) {
+        const Lanes b[4] = {hx[c] * hy[c], fx[c] * hy[c], hx[c] * fy[c], fx[c] * fy[c]};
+        for (int k = 0; k < 4; ++k) entry_bound += octagon_length(grad_x[c] * b[k], grad_y[c] * b[k]);
+      }
+    }
+    bound = to_mask<Mask>(wide) ? (to_mask<Mask>(within) ? wide_bound : entry_bound) : bound;
   }
   store(out.gradient_bound + l0, for_scan ? bound : zero - 1.0);
 }

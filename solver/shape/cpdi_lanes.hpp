@@ -70,8 +70,11 @@ struct CpdiLaneCopy {
 // gradient_bound is the octagon bound over the nodes they reach, each node's
 // entries summed in the order merged_gradients sums them (stencil.hpp), so
 // it bounds the scan's stiffening (stages.hpp: gradient_sum) and not the
-// looser sum over entries; -1 (none) where a span is over 2. The wide
-// arrays are filled only for batches of W lanes that hold a wide one.
+// looser sum over entries; where a span is over 2 (nodes past a 4 x 4
+// block), the bound over its sixteen entries as listed, the value and bits
+// of stencil.hpp's entry_gradient_sum_bound, which the scan would form from
+// the listed stencil. The wide arrays are filled only for batches of W
+// lanes that hold a wide one.
 struct CpdiLaneStencils {
   alignas(64) double weight[9][kLanes];
   alignas(64) double gradient_x[9][kLanes];
