@@ -96,39 +96,52 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
   const Ints by_corners = Ints{} + kByCorners, no_block = Ints{} + kNoBlock;
   store(out.block_first + l0, (i0 >= 0) & (j0 >= 0) ? (narrow ? i0 + j0 * g.nodes_x : by_corners) : no_block);
 
-  // Corner c's hat factors along x at the nodes i0, i0 + 1, i0 + 2: in its
-  // own cell (offset 0 or 1 from i0) 1 - fx and fx, elsewhere 0; the same
-  // along y. Their products are evaluate's bilinear weights b_k.
-  Lanes along_x[4][3], along_y[4][3];
-  for (int c = 0; c < 4; ++c) {
-    const Mask first_x = to_doubles<Lanes>(cell_i[c] - i0) == zero;
-    const Mask first_y = to_doubles<Lanes>(cell_j[c] - j0) == zero;
-    along_x[c][0] = first_x ? hx[c] : zero;
-    along_x[c][1] = first_x ? fx[c] : hx[c];
-    along_x[c][2] = first_x ? zero : fx[c];
-    along_y[c][0] = first_y ? hy[c] : zero;
-    along_y[c][1] = first_y ? fy[c] : hy[c];
-    along_y[c][2] = first_y ? zero : fy[c];
-  }
-  // The bound of stencil.hpp's entry_gradient_sum_bound over the nine.
-  Lanes bound = zero;
-  for (int b = 0; b < 3; ++b)
-    for (int a = 0; a < 3; ++a) {
-      Lanes w = zero, gsx = zero, gsy = zero;
-      for (int c = 0; c < 4; ++c) {
-        const Lanes share = along_x[c][a] * along_y[c][b];
-        w += corner_weight[c] * share;
-        gsx += grad_x[c] * share;
-        gsy += grad_y[c] * share;
-      }
-      store(out.weight[a + 3 * b] + l0, w);
-      store(out.gradient_x[a + 3 * b] + l0, gsx);
-      store(out.gradient_y[a + 3 * b] + l0, gsy);
-      if (for_scan) bound += octagon_length(gsx, gsy);
-    }
   const Ints wide = ~narrow;
-  bool any_wide = false;
-  for (int l = 0; l < W; ++l) any_wide |= wide[l] != 0;
+  bool any_narrow = false, any_wide = false;
+  for (int l = 0; l < W; ++l) {
+    any_narrow |= narrow[l] != 0;
+    any_wide |= wide[l] != 0;
+  }
+  Lanes bound = zero;
+  if (any_narrow) {
+    // Corner c's hat factors along x at the nodes i0, i0 + 1, i0 + 2: in its
+    // own cell (offset 0 or 1 from i0) 1 - fx and fx, elsewhere 0; the same
+    // along y. Their products are evaluate's bilinear weights b_k.
+    Lanes along_x[4][3], along_y[4][3];
+    for (int c = 0; c < 4; ++c) {
+      const Mask first_x = to_doubles<Lanes>(cell_i[c] - i0) == zero;
+      const Mask first_y = to_doubles<Lanes>(cell_j[c] - j0) == zero;
+      along_x[c][0] = first_x ? hx[c] : zero;
+      along_x[c][1] = first_x ? fx[c] : hx[c];
+      along_x[c][2] = first_x ? zero : fx[c];
+      along_y[c][0] = first_y ? hy[c] : zero;
+      along_y[c][1] = first_y ? fy[c] : hy[c];
+      along_y[c][2] = first_y ? zero : fy[c];
+    }
+    // The bound of stencil.hpp's entry_gradient_sum_bound over the nine.
+    for (int b = 0; b < 3; ++b)
+      for (int a = 0; a < 3; ++a) {
+        Lanes w = zero, gsx = zero, gsy = zero;
+        for (int c = 0; c < 4; ++c) {
+          const Lanes share = along_x[c][a] * along_y[c][b];
+          w += corner_weight[c] * share;
+          gsx += grad_x[c] * share;
+          gsy += grad_y[c] * share;
+        }
+        store(out.weight[a + 3 * b] + l0, w);
+        store(out.gradient_x[a + 3 * b] + l0, gsx);
+        store(out.gradient_y[a + 3 * b] + l0, gsy);
+        if (for_scan) bound += octagon_length(gsx, gsy);
+      }
+  } else {
+    // Every lane wide: no transfer reads these slots of the group's lanes,
+    // zeros keep them defined for one at another width (the tests').
+    for (int slot = 0; slot < 9; ++slot) {
+      store(out.weight[slot] + l0, zero);
+      store(out.gradient_x[slot] + l0, zero);
+      store(out.gradient_y[slot] + l0, zero);
+    }
+  }
   if (any_wide) {
     // evaluate's wide branch: corner c's bilinear weights b_k at the four
     // nodes of its cell, times its factors.
