@@ -122,8 +122,9 @@ MPMVV_JET_INLINE Jet<T, N> cos(const Jet<T, N>& a) {
 }
 // sin x and cos x of one x together: a motion that takes both (a rotation)
 // makes one call of libm's sincos where it would make two (GCC merges
-// std::sin and std::cos of one double; jet_lanes.hpp calls sincos lane by
-// lane). Each is what sin(x) and cos(x) give, to the bit.
+// std::sin and std::cos of one double; jet_lanes.hpp makes one call of the
+// lanes' sincos for four points). Each is what sin(x) and cos(x) give, to
+// the bit.
 template <class T>
 struct SinCos {
   T sin, cos;

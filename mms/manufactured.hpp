@@ -217,10 +217,10 @@ class Manufactured {
     return {motion_.time_factors(time_variable(t)), motion_.time_factors(SpaceJet(t))};
   }
   // body_force(X, t) from the point's factors and the time's: the same jets,
-  // to the bit. The jet of t takes the factors of X as constants: the value
-  // part of every jet is the plain evaluation, whatever the nesting. B is
-  // double, or four points in lanes (jet_lanes.hpp), each lane the same
-  // operations as one point's.
+  // to the bit for B = double. The jet of t takes the factors of X as
+  // constants: the value part of every jet is the plain evaluation, whatever
+  // the nesting. B is double, or four points in lanes (jet_lanes.hpp), each
+  // lane the same operations as one point's but for sin, cos and ln.
   template <class B>
   MPMVV_JET_INLINE Vec2Of<B> body_force(const Vec2Of<B>& X, const SpaceFactorsOf<B>& space,
                                         const TimeFactorsOf<B>& time) const

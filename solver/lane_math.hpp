@@ -32,8 +32,9 @@ void lane_log(std::size_t n, const double* x, double* log_x);
 void lane_log(LaneBuild build, std::size_t n, const double* x, double* log_x);
 
 // Each build's own, compiled for its instructions (solver/CMakeLists.txt).
-// sincos_array tells whether any x_k lies past kLaneSinCosLimit or is NaN.
+// sincos_array tells whether any x_k lies past kLaneSinCosLimit or is NaN,
+// log_array whether any x_k is not positive, finite and normal.
 MPMVV_LANE_KERNEL(void sincos_array(std::size_t n, const double* x, double* sin_x, double* cos_x, bool& any_beyond))
-MPMVV_LANE_KERNEL(void log_array(std::size_t n, const double* x, double* log_x))
+MPMVV_LANE_KERNEL(void log_array(std::size_t n, const double* x, double* log_x, bool& any_outside))
 
 }  // namespace mpmvv

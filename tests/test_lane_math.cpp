@@ -208,6 +208,15 @@ TEST(LaneLog, OutsideTheNormalRangeTheValuesAreLibms) {
       EXPECT_EQ(bits(l[k]), bits(std::log(x[k]))) << "x = " << x[k];
     }
     EXPECT_LE(ulps(l.back(), std::log(3.0L)), 1.0);
+    // One such argument alone, in a full vector or among the last few.
+    for (const double outside : {0.0, -2.0, 5e-324, inf, std::numeric_limits<double>::quiet_NaN()})
+      for (std::size_t at = 0; at < 11; ++at) {
+        std::vector<double> y(11, 2.0), ly(11);
+        y[at] = outside;
+        mpmvv::lane_log(build, y.size(), y.data(), ly.data());
+        if (std::isnan(std::log(outside))) EXPECT_TRUE(std::isnan(ly[at])) << outside << " at " << at;
+        else EXPECT_EQ(bits(ly[at]), bits(std::log(outside))) << outside << " at " << at;
+      }
   }
 }
 
