@@ -78,7 +78,7 @@ class FactoredForceField final : public ForceField {
     }
     const std::size_t n = count_;
     const std::size_t blocks = (n + kBlock - 1) / kBlock;
-    const LaneBuild build = build_;
+    [[maybe_unused]] const LaneBuild build = build_;  // read only on x86-64
 #pragma omp parallel for schedule(static)
     for (std::size_t k = 0; k < blocks; ++k) {
       const std::size_t first = k * kBlock, last = std::min(n, first + kBlock);
