@@ -9,11 +9,9 @@ An error that behaves as E(h) = C h^p on meshes of cell size h has
   fitted to all levels of the chosen range, with a two-sided confidence interval
       p +- t(1 - (1 - c)/2, n - 2) * s / sqrt(sum (ln h_i - mean ln h)^2),
   s^2 = (sum of squared residuals) / (n - 2), where t(q, nu) is the quantile of
-  Student's t distribution with nu degrees of freedom. The quantile is computed
-  here (no scipy): the t distribution function is written with the regularised
-  incomplete beta function, F(t) = 1 - I_x(nu/2, 1/2)/2 for t > 0 with
-  x = nu / (nu + t^2), evaluated by its continued fraction (modified Lentz), and
-  inverted by bisection.
+  Student's t distribution with nu degrees of freedom. The fit and the standard
+  error s / sqrt(...) are scipy.stats.linregress's, the quantile
+  scipy.stats.t.ppf.
 
 Classification of a range (the rule, applied in this order):
 
@@ -81,6 +79,8 @@ import math
 import sys
 from dataclasses import dataclass
 
+from scipy import stats
+
 STALLED_BELOW = 0.5
 ASYMPTOTIC_SPREAD = 0.5
 GCI_SAFETY_FACTOR = 1.25
@@ -122,19 +122,15 @@ def least_squares_order(h, error, confidence=0.95):
     nan = float("nan")
     if n < 2:
         return OrderFit(nan, nan, nan, nan, confidence, n)
-    mean_x = sum(x for x, _ in points) / n
-    mean_y = sum(y for _, y in points) / n
-    sxx = sum((x - mean_x) ** 2 for x, _ in points)
-    if sxx == 0.0:
+    x, y = zip(*points)
+    if min(x) == max(x):
         return OrderFit(nan, nan, nan, nan, confidence, n)
-    slope = sum((x - mean_x) * (y - mean_y) for x, y in points) / sxx
-    intercept = mean_y - slope * mean_x
+    fit = stats.linregress(x, y)
     if n == 2:
-        return OrderFit(slope, math.exp(intercept), nan, nan, confidence, n)
-    residual = sum((y - intercept - slope * x) ** 2 for x, y in points)
-    standard_error = math.sqrt(residual / (n - 2) / sxx)
-    half_width = student_t_quantile(0.5 + confidence / 2.0, n - 2) * standard_error
-    return OrderFit(slope, math.exp(intercept), slope - half_width, slope + half_width, confidence, n)
+        return OrderFit(float(fit.slope), math.exp(fit.intercept), nan, nan, confidence, n)
+    slope = float(fit.slope)
+    half_width = float(stats.t.ppf(0.5 + confidence / 2.0, n - 2) * fit.stderr)
+    return OrderFit(slope, math.exp(fit.intercept), slope - half_width, slope + half_width, confidence, n)
 
 
 def roundoff_floor(steps, size):
@@ -159,66 +155,6 @@ def classify(pairwise, floor=None):
     if max(finite) - min(finite) > ASYMPTOTIC_SPREAD:
         return "non-asymptotic"
     return "asymptotic"
-
-
-def regularized_incomplete_beta(x, a, b):
-    """I_x(a, b) for 0 <= x <= 1, a, b > 0 by the continued fraction of
-    Numerical Recipes (3rd ed.) sec. 6.4, eq. 6.4.5, evaluated by modified Lentz,
-    on the side of the symmetry I_x(a, b) = 1 - I_{1-x}(b, a) where it converges fast."""
-    if x <= 0.0:
-        return 0.0
-    if x >= 1.0:
-        return 1.0
-    log_front = (math.lgamma(a + b) - math.lgamma(a) - math.lgamma(b)
-                 + a * math.log(x) + b * math.log1p(-x))
-    if x < (a + 1.0) / (a + b + 2.0):
-        return math.exp(log_front) * _beta_continued_fraction(x, a, b) / a
-    return 1.0 - math.exp(log_front) * _beta_continued_fraction(1.0 - x, b, a) / b
-
-
-def _beta_continued_fraction(x, a, b, tolerance=1e-15, max_terms=1000):
-    tiny = 1e-300
-    c = 1.0
-    d = 1.0 - (a + b) * x / (a + 1.0)
-    d = 1.0 / (d if abs(d) > tiny else tiny)
-    result = d
-    for m in range(1, max_terms + 1):
-        for numerator in (m * (b - m) * x / ((a + 2 * m - 1) * (a + 2 * m)),
-                          -(a + m) * (a + b + m) * x / ((a + 2 * m) * (a + 2 * m + 1))):
-            d = 1.0 + numerator * d
-            d = 1.0 / (d if abs(d) > tiny else tiny)
-            c = 1.0 + numerator / c
-            c = c if abs(c) > tiny else tiny
-            result *= c * d
-        if abs(c * d - 1.0) < tolerance:
-            return result
-    return result
-
-
-def student_t_cdf(t, dof):
-    """P(T <= t) for Student's t with dof degrees of freedom."""
-    tail = 0.5 * regularized_incomplete_beta(dof / (dof + t * t), 0.5 * dof, 0.5)
-    return 1.0 - tail if t > 0 else tail
-
-
-def student_t_quantile(probability, dof):
-    """t such that P(T <= t) = probability, by bisection on the distribution function."""
-    if not 0.0 < probability < 1.0:
-        raise ValueError(f"probability must lie in (0, 1), not {probability}")
-    if probability < 0.5:
-        return -student_t_quantile(1.0 - probability, dof)
-    low, high = 0.0, 1.0
-    while student_t_cdf(high, dof) < probability:
-        low, high = high, 2.0 * high
-    for _ in range(200):
-        middle = 0.5 * (low + high)
-        if student_t_cdf(middle, dof) < probability:
-            low = middle
-        else:
-            high = middle
-        if high - low <= 1e-13 * high:
-            break
-    return 0.5 * (low + high)
 
 
 def richardson_extrapolate(fine, coarse, ratio, order):

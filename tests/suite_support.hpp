@@ -12,6 +12,8 @@
 #include <sstream>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 namespace mpmvv::suite_testing {
 
 namespace fs = std::filesystem;
@@ -47,6 +49,16 @@ inline int shell(const std::string& command) {
 inline int count(const std::string& text, const std::string& what) {
   int n = 0;
   for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+// The cases of a manifest (its text) whose status is `status`; -1 where the
+// text is no manifest.
+inline int cases_with_status(const std::string& manifest, const std::string& status) {
+  const nlohmann::json j = nlohmann::json::parse(manifest, nullptr, /*allow_exceptions=*/false);
+  if (!j.is_object() || !j.contains("cases") || !j["cases"].is_array()) return -1;
+  int n = 0;
+  for (const nlohmann::json& c : j["cases"]) n += c.is_object() && c.value("status", "") == status;
   return n;
 }
 

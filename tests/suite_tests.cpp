@@ -66,9 +66,9 @@ TEST(SuiteFile, ExpandsSweepZipAndOverrides) {
   EXPECT_EQ(s.cases[7].id, "r-method=cpdi-cells=64-particles_per_direction=3-cfl=0.2");
   int overridden = 0;
   for (const auto& c : s.cases) {
-    const bool match = c.keys.at("cells") == "64" && c.keys.at("method") == "\"cpdi\"";
+    const bool match = c.keys.at("cells") == 64 && c.keys.at("method") == "cpdi";
     overridden += match;
-    EXPECT_EQ(c.keys.at("probe_points"), match ? "11" : "51") << c.id;
+    EXPECT_EQ(c.keys.at("probe_points"), match ? 11 : 51) << c.id;
     EXPECT_NE(c.configuration.find("end_time = 0.25"), std::string::npos) << c.id;
   }
   EXPECT_EQ(overridden, 2);
@@ -186,8 +186,8 @@ TEST(SuiteRunner, CrashAndHangAreIsolated) {
                            suite.string() + " -j 2 -q -o " + (dir / "out").string());
   EXPECT_EQ(status, 1);
   const std::string manifest = read(dir / "out" / "manifest.json");
-  EXPECT_EQ(count(manifest, "\"status\": \"completed\""), 2) << manifest;
-  EXPECT_EQ(count(manifest, "\"status\": \"crashed\""), 1) << manifest;
+  EXPECT_EQ(cases_with_status(manifest, "completed"), 2) << manifest;
+  EXPECT_EQ(cases_with_status(manifest, "crashed"), 1) << manifest;
   EXPECT_TRUE(fs::exists(dir / "out/cases/square-cells=8.h5"));
   EXPECT_FALSE(fs::exists(dir / "out/cases/square-cells=12.h5"));
 
@@ -195,10 +195,44 @@ TEST(SuiteRunner, CrashAndHangAreIsolated) {
                          suite.string() + " -j 2 -q -o " + (dir / "hang").string());
   EXPECT_EQ(hung, 1);
   const std::string hang_manifest = read(dir / "hang" / "manifest.json");
-  EXPECT_EQ(count(hang_manifest, "\"status\": \"timeout\""), 1) << hang_manifest;
-  EXPECT_EQ(count(hang_manifest, "\"status\": \"completed\""), 2) << hang_manifest;
+  EXPECT_EQ(cases_with_status(hang_manifest, "timeout"), 1) << hang_manifest;
+  EXPECT_EQ(cases_with_status(hang_manifest, "completed"), 2) << hang_manifest;
   for (const auto& entry : fs::recursive_directory_iterator(dir))
     EXPECT_EQ(entry.path().string().find(".partial"), std::string::npos) << entry.path();
+}
+
+// The manifest and each case's file are JSON that a reader parses back to
+// what the suite holds: a description with quotes, a backslash, a tab, a
+// newline and a non-ASCII letter, keys as numbers and strings, a crashed
+// case's status and exit code.
+TEST(SuiteRunner, TheManifestIsJsonWhateverItsTextsHold) {
+  const fs::path dir = scratch("json");
+  // TOML's escapes in the file; the same characters in `description`.
+  const std::string description = "the \"square\" \\ at\tonce\nand \u00e9";
+  const fs::path suite =
+      write(dir / "s.toml", R"(description = "the \"square\" \\ at\tonce\nand \u00e9")" "\n" + small_suite(30));
+  const int status = shell("MPMVV_FAULT=crash MPMVV_FAULT_ONLY=cells=12 " + std::string(MPMVV_BINARY) + " suite " +
+                           suite.string() + " -j 2 -q -o " + (dir / "out").string());
+  EXPECT_EQ(status, 1);
+  const nlohmann::json manifest =
+      nlohmann::json::parse(read(dir / "out" / "manifest.json"), nullptr, /*allow_exceptions=*/false);
+  ASSERT_TRUE(manifest.is_object()) << read(dir / "out" / "manifest.json");
+  EXPECT_EQ(manifest["suite"], "s");
+  EXPECT_EQ(manifest["description"], description);
+  ASSERT_EQ(manifest["cases"].size(), 3u);
+  for (const nlohmann::json& c : manifest["cases"]) {
+    const std::string id = c["id"];
+    const nlohmann::json own = nlohmann::json::parse(read(dir / "out" / "cases" / (id + ".json")), nullptr, false);
+    EXPECT_EQ(own, c) << id;
+    EXPECT_TRUE(c["keys"]["cells"].is_number_integer()) << c;
+    EXPECT_EQ(c["keys"]["variant"], "2d") << c;
+    EXPECT_TRUE(c["wall_time_s"].is_number()) << c;
+    const bool crashed = c["keys"]["cells"] == 12;
+    EXPECT_EQ(c["status"], crashed ? "crashed" : "completed") << c;
+    if (crashed) {
+      EXPECT_NE(c["exit_code"], 0) << c;
+    }
+  }
 }
 
 // A rerun keeps every case whose results file holds the same configuration
@@ -214,7 +248,7 @@ TEST(SuiteRunner, ResumeRunsOnlyWhatIsMissing) {
   ASSERT_EQ(shell(run), 0);
   const std::string manifest = read(dir / "out" / "manifest.json");
   EXPECT_EQ(count(manifest, "kept from an earlier run"), 2) << manifest;
-  EXPECT_EQ(count(manifest, "\"status\": \"completed\""), 3) << manifest;
+  EXPECT_EQ(cases_with_status(manifest, "completed"), 3) << manifest;
   EXPECT_EQ(fs::last_write_time(kept), written);
   EXPECT_TRUE(fs::exists(dir / "out/cases/square-cells=16.h5"));
   // A changed configuration is not kept.
@@ -350,14 +384,14 @@ TEST(SuiteRunner, AFullDiskEndsACaseOrTheSuiteWithOneLine) {
   const std::string manifest = read(out / "manifest.json");
   ASSERT_GE(manifest.size(), 4u);
   EXPECT_EQ(manifest.substr(manifest.size() - 4), "\n]}\n") << manifest;
-  EXPECT_EQ(count(manifest, "\"status\": \"completed\""), 1) << manifest;
-  EXPECT_EQ(count(manifest, "\"status\": \"pending\""), 2) << manifest;
+  EXPECT_EQ(cases_with_status(manifest, "completed"), 1) << manifest;
+  EXPECT_EQ(cases_with_status(manifest, "pending"), 2) << manifest;
   // The case that finished before the manifest failed (-j 1: the first) is kept.
   EXPECT_TRUE(fs::exists(out / "cases/square-cells=12.h5"));
   fs::remove(out / "manifest.json.partial");
   ASSERT_EQ(shell(run), 0);
   const std::string resumed = read(out / "manifest.json");
-  EXPECT_EQ(count(resumed, "\"status\": \"completed\""), 3) << resumed;
+  EXPECT_EQ(cases_with_status(resumed, "completed"), 3) << resumed;
   EXPECT_EQ(count(resumed, "kept from an earlier run"), 2) << resumed;
 }
 
@@ -389,12 +423,12 @@ TEST(SuiteRunner, OnlyRunsTheSelectedCases) {
   const std::string run = std::string(MPMVV_BINARY) + " suite " + suite.string() + " -j 2 -q -o " + (dir / "out").string();
   ASSERT_EQ(shell(run + " --only 'cells=(8|16)$'"), 0);
   std::string manifest = read(dir / "out" / "manifest.json");
-  EXPECT_EQ(count(manifest, "\"status\": \"completed\""), 2) << manifest;
-  EXPECT_EQ(count(manifest, "\"status\": \"pending\""), 1) << manifest;
+  EXPECT_EQ(cases_with_status(manifest, "completed"), 2) << manifest;
+  EXPECT_EQ(cases_with_status(manifest, "pending"), 1) << manifest;
   EXPECT_FALSE(fs::exists(dir / "out/cases/square-cells=12.h5"));
   ASSERT_EQ(shell(run), 0);
   manifest = read(dir / "out" / "manifest.json");
-  EXPECT_EQ(count(manifest, "\"status\": \"completed\""), 3) << manifest;
+  EXPECT_EQ(cases_with_status(manifest, "completed"), 3) << manifest;
   EXPECT_EQ(count(manifest, "kept from an earlier run"), 2) << manifest;
   EXPECT_EQ(shell(run + " --only '('"), 2);
   // A selection of nothing is a mistake, not a finished run.
@@ -440,7 +474,7 @@ TEST(SuiteRunner, ResultsOlderThanAKeyAreKeptOnlyAtItsDefault) {
   EXPECT_TRUE(mpmvv::app::same_configuration(c.configuration, c.configuration, c.defaults, &added));
   EXPECT_TRUE(added.empty());
   // probe_points and dilatation are at their defaults in this case; cells and end_time are not.
-  ASSERT_EQ(c.keys.at("probe_points"), "51");
+  ASSERT_EQ(c.keys.at("probe_points"), 51);
   const std::string older = without(without(c.configuration, "probe_points"), "dilatation");
   EXPECT_TRUE(mpmvv::app::same_configuration(older, c.configuration, c.defaults, &added));
   EXPECT_EQ(added, (std::vector<std::string>{"dilatation", "probe_points"}));
@@ -449,6 +483,13 @@ TEST(SuiteRunner, ResultsOlderThanAKeyAreKeptOnlyAtItsDefault) {
   EXPECT_FALSE(mpmvv::app::same_configuration(older, with(c.configuration, "probe_points", "11"), c.defaults));
   EXPECT_FALSE(mpmvv::app::same_configuration(with(c.configuration, "cfl", "0.25"), c.configuration, c.defaults));
   EXPECT_FALSE(mpmvv::app::same_configuration(c.configuration + "retired_key = 1\n", c.configuration, c.defaults));
+  // The same values written otherwise are the same configuration; another
+  // value, or a text that is no TOML, is not.
+  EXPECT_TRUE(mpmvv::app::same_configuration(with(with(c.configuration, "end_time", "5.0e-3"), "output_times", "[ 0.005 ]"),
+                                             c.configuration, c.defaults));
+  EXPECT_FALSE(mpmvv::app::same_configuration(with(c.configuration, "end_time", "0.0050000000000001"), c.configuration,
+                                              c.defaults));
+  EXPECT_FALSE(mpmvv::app::same_configuration(with(c.configuration, "end_time", "= 0.005"), c.configuration, c.defaults));
 }
 
 #ifdef MPMVV_HAVE_MPI
@@ -461,7 +502,7 @@ TEST(SuiteRunner, MpiRanksShareTheCases) {
                            suite.string() + " -q -o " + (dir / "out").string());
   ASSERT_EQ(status, 0);
   const std::string manifest = read(dir / "out" / "manifest.json");
-  EXPECT_EQ(count(manifest, "\"status\": \"completed\""), 3) << manifest;
+  EXPECT_EQ(cases_with_status(manifest, "completed"), 3) << manifest;
   EXPECT_TRUE(fs::exists(dir / "out" / "summary.txt"));
 }
 #endif  // MPMVV_HAVE_MPI

@@ -5,11 +5,14 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <optional>
 #include <string>
 #include <vector>
+
+#include <toml++/toml.h>
 
 #include "tools/app/config.hpp"
 #include "tools/app/scene.hpp"
@@ -185,6 +188,22 @@ TEST_F(SceneFile, ResolvedConfigurationReadsBack) {
   for (const KeySpec& k : original.specs())
     EXPECT_EQ(mpmvv::app::format_value(reread.value(k.name)), mpmvv::app::format_value(original.value(k.name)))
         << k.name;
+}
+
+// A text value with quotes, a backslash, a tab, a newline and a non-ASCII
+// letter is written escaped: the resolved configuration stays TOML, one line
+// a key, and reads back to the same text.
+TEST(ConfigText, AnyTextReadsBackFromTheResolvedConfiguration) {
+  const std::string text = "a \"quoted\" \\ path\twith\nlines \u00e9";
+  Config c("free", {KeySpec{"label", mpmvv::app::KeyKind::text, std::string("plain"), "a label"},
+                    KeySpec{"size", mpmvv::app::KeyKind::real, 1.0, "a size"}});
+  c.set("label", text, {"test"});
+  const std::string resolved = c.to_toml();
+  EXPECT_EQ(std::count(resolved.begin(), resolved.end(), '\n'), 3) << resolved;
+  const toml::table t = toml::parse(resolved);
+  EXPECT_EQ(t["scene"].value<std::string>(), "free");
+  EXPECT_EQ(t["label"].value<std::string>(), text) << resolved;
+  EXPECT_EQ(t["size"].value<double>(), 1.0) << resolved;
 }
 
 // ---------------------------------------------------------------- --set overrides

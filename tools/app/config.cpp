@@ -78,13 +78,28 @@ std::string real_text(double x) {
   return s;
 }
 
+namespace {
+
+// A string as a TOML basic string, escaped by toml++ (quotes, backslashes,
+// control and non-ASCII characters), so that the text reads back as the same
+// string. Numbers are written above rather than by toml++, which gives a
+// double seventeen digits (0.1 as 0.10000000000000001): the shortest text is
+// the one a person wrote in the scene file.
+std::string toml_string(const std::string& x) {
+  std::ostringstream s;
+  s << toml::toml_formatter{toml::value<std::string>(x), toml::format_flags::none};
+  return s.str();
+}
+
+}  // namespace
+
 std::string format_value(const Value& v) {
   return std::visit(
       [](const auto& x) -> std::string {
         using T = std::decay_t<decltype(x)>;
         if constexpr (std::is_same_v<T, std::int64_t>) return std::to_string(x);
         else if constexpr (std::is_same_v<T, double>) return real_text(x);
-        else if constexpr (std::is_same_v<T, std::string>) return "\"" + x + "\"";
+        else if constexpr (std::is_same_v<T, std::string>) return toml_string(x);
         else {
           std::string s = "[";
           for (std::size_t i = 0; i < x.size(); ++i) s += (i ? ", " : "") + real_text(x[i]);
@@ -230,7 +245,7 @@ const std::vector<double>& Config::reals(const std::string& key) const {
 }
 
 std::string Config::to_toml() const {
-  std::string out = fmt::format("scene = \"{}\"\n", scene_);
+  std::string out = fmt::format("scene = {}\n", toml_string(scene_));
   for (const KeySpec& s : specs_) out += fmt::format("{} = {}\n", s.name, format_value(values_.at(s.name)));
   return out;
 }

@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 #include <fmt/ostream.h>
+#include <nlohmann/json.hpp>
 
 #include "mms_scene.hpp"
 
@@ -31,10 +32,8 @@ ProblemSetup setup_for(const MmsProblem& problem, const std::vector<std::string>
   return problem.setup(config);
 }
 
-std::string json_vector(const Vec2& v) { return fmt::format("[{:.17g}, {:.17g}]", v.x(), v.y()); }
-std::string json_matrix(const Mat2& m) {
-  return fmt::format("[[{:.17g}, {:.17g}], [{:.17g}, {:.17g}]]", m(0, 0), m(0, 1), m(1, 0), m(1, 1));
-}
+nlohmann::ordered_json json_of(const Vec2& v) { return {v.x(), v.y()}; }
+nlohmann::ordered_json json_of(const Mat2& m) { return {{m(0, 0), m(0, 1)}, {m(1, 0), m(1, 1)}}; }
 
 }  // namespace
 
@@ -72,15 +71,24 @@ int mms_eval(const MmsEvalRequest& r, std::ostream& out, std::ostream& err) {
   const mms::ExactFields f = setup.solution->fields(X, r.time);
   const bool rz = setup.geometry == Geometry::axisymmetric;
   if (r.json) {
-    fmt::print(out,
-               "{{\"solution\": \"{}\", \"geometry\": \"{}\", \"reference_position\": {}, \"time\": {:.17g}, "
-               "\"position\": {}, \"displacement\": {}, \"velocity\": {}, \"acceleration\": {}, \"F\": {}, "
-               "\"F33\": {:.17g}, \"J\": {:.17g}, \"cauchy_stress\": {}, \"cauchy_stress_33\": {:.17g}, "
-               "\"first_piola\": {}, \"first_piola_33\": {:.17g}, \"body_force\": {}}}\n",
-               r.name, to_string(setup.geometry), json_vector(X), r.time, json_vector(f.position),
-               json_vector(f.displacement), json_vector(f.velocity), json_vector(f.acceleration),
-               json_matrix(f.deformation_gradient), f.hoop_stretch, f.J, json_matrix(f.cauchy_stress),
-               f.cauchy_stress_33, json_matrix(f.first_piola), f.first_piola_33, json_vector(f.body_force));
+    // Doubles to their shortest exact text; a NaN or an infinity as null.
+    const nlohmann::ordered_json j = {{"solution", r.name},
+                                      {"geometry", to_string(setup.geometry)},
+                                      {"reference_position", json_of(X)},
+                                      {"time", r.time},
+                                      {"position", json_of(f.position)},
+                                      {"displacement", json_of(f.displacement)},
+                                      {"velocity", json_of(f.velocity)},
+                                      {"acceleration", json_of(f.acceleration)},
+                                      {"F", json_of(f.deformation_gradient)},
+                                      {"F33", f.hoop_stretch},
+                                      {"J", f.J},
+                                      {"cauchy_stress", json_of(f.cauchy_stress)},
+                                      {"cauchy_stress_33", f.cauchy_stress_33},
+                                      {"first_piola", json_of(f.first_piola)},
+                                      {"first_piola_33", f.first_piola_33},
+                                      {"body_force", json_of(f.body_force)}};
+    fmt::print(out, "{}\n", j.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace));
     return 0;
   }
   const char* third = rz ? "theta" : "zz";

@@ -173,25 +173,8 @@ std::vector<Axis> axes_of(const toml::table& table, const std::string& file, con
   return axes;
 }
 
-std::string json_string(const std::string& s) {
-  std::string out = "\"";
-  for (const char c : s) {
-    switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) out += fmt::format("\\u{:04x}", int(c));
-        else out += c;
-    }
-  }
-  return out + "\"";
-}
-
-std::string json_value(const Value& v) {
-  if (const auto* s = std::get_if<std::string>(&v)) return json_string(*s);
-  return format_value(v);  // numbers and lists of numbers are already JSON
+Json json_of(const Value& v) {
+  return std::visit([](const auto& x) { return Json(x); }, v);
 }
 
 std::string id_part(const Value& v) {
@@ -215,13 +198,9 @@ bool case_has(const SuiteCase& c, const std::string& key, const Value& value) {
   if (found == c.keys.end()) return false;
   if (std::holds_alternative<std::int64_t>(value) || std::holds_alternative<double>(value)) {
     const double wanted = std::holds_alternative<double>(value) ? std::get<double>(value) : double(std::get<std::int64_t>(value));
-    try {
-      return std::stod(found->second) == wanted;
-    } catch (const std::exception&) {
-      return false;  // a string-valued key
-    }
+    return found->second.is_number() && found->second.get<double>() == wanted;
   }
-  return found->second == json_value(value);
+  return found->second == json_of(value);
 }
 
 // [[reference]] tables: published numbers the report sets beside the suite's
@@ -502,7 +481,7 @@ Suite load_suite(const std::string& path) {
         if (!first_of_study.count(name)) first_of_study[name] = std::move(built);
         c.configuration = config.to_toml();
         c.defaults = Config(config.scene(), specs).to_toml();
-        for (const KeySpec& k : specs) c.keys[k.name] = json_value(config.value(k.name));
+        for (const KeySpec& k : specs) c.keys[k.name] = json_of(config.value(k.name));
         for (const SuiteCase& other : suite.cases)
           if (other.id == c.id) throw ConfigError(fmt::format("{}: two cases have the id '{}'", here, c.id));
         // The id names the case's files (cases/<id>.h5.partial the longest),
@@ -585,7 +564,9 @@ Suite load_suite(const std::string& path) {
           throw ConfigError(fmt::format("{}: [[expect]]: 'levels' must list two or more values of '{}'", where_in(path, *l), refine));
         for (double level : std::get<std::vector<double>>(*v)) {
           const bool present = std::any_of(suite.cases.begin(), suite.cases.end(), [&](const SuiteCase& c) {
-            return c.study == name && c.keys.count(refine) && std::abs(std::stod(c.keys.at(refine)) - level) < 1e-12 * std::max(1.0, std::abs(level));
+            const auto key = c.keys.find(refine);
+            return c.study == name && key != c.keys.end() && key->second.is_number() &&
+                   std::abs(key->second.get<double>() - level) < 1e-12 * std::max(1.0, std::abs(level));
           });
           if (!present)
             throw ConfigError(fmt::format("{}: [[expect]]: study '{}' has no case with {} = {}", where_in(path, *l), name, refine, level));
@@ -611,16 +592,39 @@ struct CaseState {
   std::string detail;
 };
 
-std::string case_json(const SuiteCase& c, const CaseState& s, const std::string& results) {
-  std::string keys;
-  for (const auto& [k, v] : c.keys) keys += (keys.empty() ? "" : ", ") + json_string(k) + ": " + v;
-  std::string overrides;
-  for (const std::string& o : c.overrides) overrides += (overrides.empty() ? "" : ", ") + json_string(o);
-  return fmt::format(
-      "{{\"id\": {}, \"study\": {}, \"scene\": {}, \"keys\": {{{}}}, \"overrides\": [{}], \"results\": {}, "
-      "\"status\": {}, \"exit_code\": {}, \"wall_time_s\": {}, \"detail\": {}}}",
-      json_string(c.id), json_string(c.study), json_string(c.scene_file), keys, overrides, json_string(results),
-      json_string(s.status), s.exit_code, fmt::format("{:.6g}", s.wall), json_string(s.detail));
+Json case_json(const SuiteCase& c, const CaseState& s, const std::string& results) {
+  Json keys = Json::object();
+  for (const auto& [k, v] : c.keys) keys[k] = v;
+  return {{"id", c.id},
+          {"study", c.study},
+          {"scene", c.scene_file},
+          {"keys", std::move(keys)},
+          {"overrides", c.overrides},
+          {"results", results},
+          {"status", s.status},
+          {"exit_code", s.exit_code},
+          {"wall_time_s", s.wall},
+          {"detail", s.detail}};
+}
+
+// JSON's text: a NaN or an infinity is written null, and bytes that are not
+// UTF-8 (a solver's message) as U+FFFD, so the file always parses.
+std::string json_text(const Json& j, int indent = -1) {
+  return j.dump(indent, ' ', false, Json::error_handler_t::replace);
+}
+
+// Member `key` of object j where it holds a T, else `fallback`.
+template <class T>
+T member(const Json& j, const char* key, T fallback) {
+  if (!j.is_object()) return fallback;
+  const auto at = j.find(key);
+  if (at == j.end()) return fallback;
+  if constexpr (std::is_same_v<T, std::string>) {
+    if (at->is_string()) return at->template get<std::string>();
+  } else {
+    if (at->is_number()) return at->template get<T>();
+  }
+  return fallback;
 }
 
 // Written whole under a partial name, then renamed over `path`: a full disk
@@ -640,6 +644,13 @@ std::string read_text(const fs::path& path) {
   return s.str();
 }
 
+// A file's JSON, or null where it is missing or does not parse (a case file
+// cut short by a full disk).
+Json read_json(const fs::path& path) {
+  if (!fs::exists(path)) return nullptr;
+  return Json::parse(read_text(path), nullptr, /*allow_exceptions=*/false);
+}
+
 // The last non-empty line of a log: the one-line message of a refused run.
 std::string last_line(const fs::path& log) {
   std::istringstream in(read_text(log));
@@ -649,37 +660,34 @@ std::string last_line(const fs::path& log) {
   return last;
 }
 
-// What a results file says of its run, or nothing when it is not a
-// finished results file of this configuration.
-// "key = value" lines of a resolved configuration, by key.
-std::map<std::string, std::string> configuration_lines(const std::string& text) {
-  std::map<std::string, std::string> lines;
-  std::istringstream in(text);
-  for (std::string line; std::getline(in, line);) {
-    const auto eq = line.find(" = ");
-    if (eq != std::string::npos) lines[line.substr(0, eq)] = line.substr(eq + 3);
+// A resolved configuration's keys (Config::to_toml), or nothing where the
+// text is no TOML.
+std::optional<toml::table> configuration_table(const std::string& text) {
+  try {
+    return toml::parse(text);
+  } catch (const toml::parse_error&) {
+    return std::nullopt;
   }
-  return lines;
 }
 
 }  // namespace
 
+// Key by key, by value (toml++'s equality: 0.5 however it was written), so
+// that a change in how values are written never runs a finished case again.
 bool same_configuration(const std::string& stored, const std::string& wanted, const std::string& defaults,
                         std::vector<std::string>* added) {
   if (stored == wanted) return true;
-  const auto old_lines = configuration_lines(stored);
-  const auto new_lines = configuration_lines(wanted);
-  const auto default_lines = configuration_lines(defaults);
+  const auto old_keys = configuration_table(stored);
+  const auto new_keys = configuration_table(wanted);
+  const auto default_keys = configuration_table(defaults);
+  if (!old_keys || !new_keys || !default_keys) return false;
   std::vector<std::string> missing;
-  for (const auto& [key, value] : old_lines) {
-    const auto it = new_lines.find(key);
-    if (it == new_lines.end() || it->second != value) return false;
-  }
-  for (const auto& [key, value] : new_lines) {
-    if (old_lines.count(key)) continue;
-    const auto it = default_lines.find(key);
-    if (it == default_lines.end() || it->second != value) return false;
-    missing.push_back(key);
+  for (const auto& [key, value] : *old_keys)
+    if (!new_keys->contains(key.str()) || toml::node_view(value) != (*new_keys)[key.str()]) return false;
+  for (const auto& [key, value] : *new_keys) {
+    if (old_keys->contains(key.str())) continue;
+    if (!default_keys->contains(key.str()) || toml::node_view(value) != (*default_keys)[key.str()]) return false;
+    missing.push_back(std::string(key.str()));
   }
   if (added) *added = missing;
   return true;
@@ -687,6 +695,8 @@ bool same_configuration(const std::string& stored, const std::string& wanted, co
 
 namespace {
 
+// What a results file says of its run, or nothing when it is not a
+// finished results file of this configuration.
 std::optional<CaseState> finished_state(const fs::path& results, const SuiteCase& c) {
   if (!fs::exists(results)) return std::nullopt;
   try {
@@ -905,13 +915,12 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
     }  // else the descriptor stays open, and the lock held, until this process exits
     const fs::path manifest = dir / "manifest.json";
     if (!refused && fs::exists(manifest) && !request.force) {
-      std::smatch m;
-      const std::string text = read_text(manifest);
-      if (std::regex_search(text, m, std::regex("\"suite\": \"((?:[^\"\\\\]|\\\\.)*)\"")) && m[1].str() != suite.name) {
+      const std::string other = member<std::string>(read_json(manifest), "suite", suite.name);
+      if (other != suite.name) {
         refused = 1;
         refusal = fmt::format("-o {}: the directory holds the results of suite '{}' (its manifest.json); choose "
                               "another directory, or --force to run '{}' there and replace that manifest",
-                              dir.string(), m[1].str(), suite.name);
+                              dir.string(), other, suite.name);
       }
     }
   }
@@ -929,29 +938,30 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
   auto results_of = [&](std::size_t i) { return cases_dir / (suite.cases[i].id + ".h5"); };
   auto relative_results = [&](std::size_t i) { return "cases/" + suite.cases[i].id + ".h5"; };
   auto record = [&](std::size_t i) {
-    write_atomically(cases_dir / (suite.cases[i].id + ".json"), case_json(suite.cases[i], state[i], relative_results(i)) + "\n");
+    write_atomically(cases_dir / (suite.cases[i].id + ".json"),
+                     json_text(case_json(suite.cases[i], state[i], relative_results(i))) + "\n");
   };
   auto write_manifest = [&]() {
-    std::string cases;
+    Json cases = Json::array();
     for (std::size_t i = 0; i < n; ++i) {
-      const fs::path status_file = cases_dir / (suite.cases[i].id + ".json");
-      std::string object;
-      if (fs::exists(status_file)) {
-        object = read_text(status_file);
-        while (!object.empty() && (object.back() == '\n' || object.back() == ' ')) object.pop_back();
-      } else {
-        object = case_json(suite.cases[i], CaseState{}, relative_results(i));
-      }
-      cases += (i ? ",\n  " : "\n  ") + object;
+      Json object = read_json(cases_dir / (suite.cases[i].id + ".json"));
+      if (!object.is_object()) object = case_json(suite.cases[i], CaseState{}, relative_results(i));
+      cases.push_back(std::move(object));
     }
     const std::time_t now = std::time(nullptr);
     char stamp[32];
     std::strftime(stamp, sizeof stamp, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
-    write_atomically(dir / "manifest.json",
-                     fmt::format("{{\"suite\": {}, \"suite_file\": {}, \"description\": {}, \"written\": {}, "
-                                 "\"cases\": [{}\n]}}\n",
-                                 json_string(suite.name), json_string(suite.file), json_string(suite.description),
-                                 json_string(stamp), cases));
+    const Json head = {{"suite", suite.name},
+                       {"suite_file", suite.file},
+                       {"description", suite.description},
+                       {"written", stamp}};
+    // Each value written by nlohmann, a case a line, so that a manifest of
+    // hundreds of cases reads (and greps) case by case.
+    std::string text = "{";
+    for (const auto& [key, value] : head.items()) text += json_text(key) + ": " + json_text(value) + ", ";
+    text += "\"cases\": [";
+    for (std::size_t i = 0; i < cases.size(); ++i) text += (i ? ",\n  " : "\n  ") + json_text(cases[i]);
+    write_atomically(dir / "manifest.json", text + "\n]}\n");
   };
 
   // A write of the suite's own files that fails (a full disk) stops the
@@ -1139,13 +1149,10 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
     std::map<std::string, int> counts;
     for (std::size_t i = 0; i < n; ++i) {
       const fs::path status_file = cases_dir / (suite.cases[i].id + ".json");
-      const std::string json = fs::exists(status_file) ? read_text(status_file) : "";
-      std::smatch m;
-      const std::string case_status =
-          std::regex_search(json, m, std::regex("\"status\": \"([a-z]+)\"")) ? m[1].str() : std::string("pending");
-      const double wall = std::regex_search(json, m, std::regex("\"wall_time_s\": ([0-9.eE+-]+)")) ? std::stod(m[1].str()) : 0.0;
-      const std::string detail =
-          std::regex_search(json, m, std::regex("\"detail\": \"((?:[^\"\\\\]|\\\\.)*)\"")) ? m[1].str() : std::string();
+      const Json json = read_json(status_file);
+      const std::string case_status = member<std::string>(json, "status", "pending");
+      const double wall = member<double>(json, "wall_time_s", 0.0);
+      const std::string detail = member<std::string>(json, "detail", "");
       ++counts[case_status];
       const std::string error = fs::exists(results_of(i)) ? headline_error(results_of(i)) : "";
       table += fmt::format("{:<48} {:<10} {:>9.3g}  {}\n", suite.cases[i].id, case_status, wall,

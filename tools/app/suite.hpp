@@ -9,7 +9,13 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 namespace mpmvv::app {
+
+// The manifest's and the case files' JSON, its objects' members in the order
+// written.
+using Json = nlohmann::ordered_json;
 
 // One run of a scene: the key=value overrides that make it, in order.
 struct SuiteCase {
@@ -19,7 +25,7 @@ struct SuiteCase {
   std::vector<std::string> overrides;  // "key=value"
   std::string configuration;           // the resolved configuration (TOML), to recognise a finished case
   std::string defaults;                // the scene's defaults in the same form, for results older than a key
-  std::map<std::string, std::string> keys;  // every resolved scene key, as JSON values
+  std::map<std::string, Json> keys;  // every resolved scene key: a number, a string or a list of numbers
 };
 
 struct Suite {
