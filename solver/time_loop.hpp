@@ -11,7 +11,7 @@
 #include <utility>
 #include <vector>
 
-#include "explicit_stepper.hpp"
+#include "stepper.hpp"
 
 namespace mpmvv {
 

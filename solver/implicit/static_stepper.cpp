@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "newton_krylov.hpp"
+#include "solver/explicit_stepper.hpp"
 #include "solver/shape/cpdi.hpp"
 #include "solver/shape/cpdi_exact.hpp"
 #include "solver/shape/gimp.hpp"

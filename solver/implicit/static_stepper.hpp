@@ -18,7 +18,7 @@
 
 #include <memory>
 
-#include "solver/explicit_stepper.hpp"
+#include "solver/stepper.hpp"
 
 namespace mpmvv {
 

@@ -4,6 +4,7 @@
 #include "solver/io/state_archive.hpp"
 #include "solver/parallel.hpp"
 #ifdef MPMVV_HAVE_SUNDIALS
+#include "solver/explicit_stepper.hpp"
 #include "solver/implicit/static_stepper.hpp"
 #endif
 

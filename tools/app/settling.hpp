@@ -28,7 +28,7 @@
 #include <utility>
 #include <vector>
 
-#include "solver/explicit_stepper.hpp"
+#include "solver/stepper.hpp"
 #include "solver/particles.hpp"
 
 namespace mpmvv::app {
