@@ -238,7 +238,8 @@ def hertz_cases(history=True, contact_pressure=True, measurements=True):
         case.update(h=h, times=[HERTZ_END_TIME], errors={"error_peak_pressure": [0.5 / cells]})
         if contact_pressure:
             case["contact_pressure"] = {"x": x, "time": [HERTZ_END_TIME], "pressure": [exact * (1.0 + 2.0 * h / a)],
-                                        "exact_pressure": [exact]}
+                                        "exact_pressure": [exact], "exact_peak_pressure": [p0],
+                                        "exact_half_width": [a]}
         if history:
             steps = np.linspace(0.0, HERTZ_END_TIME, 50 * cells // 25)
             approach = 2e-4 * np.minimum(steps / (0.5 * HERTZ_END_TIME), 1.0)

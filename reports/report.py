@@ -502,22 +502,6 @@ def level_styles(series):
             for k, c in enumerate(series.cases)}
 
 
-def hertz_ellipse(x, exact):
-    """(p0, a) of the curve p0 sqrt(1 - x^2/a^2) the nonzero exact pressures lie on
-    (p^2 is linear in x^2), or None with fewer than two such points or when they
-    do not lie on one."""
-    x, p = np.asarray(x, float), np.asarray(exact, float)
-    on = np.isfinite(x) & np.isfinite(p) & (p > 0)
-    if on.sum() < 2 or np.unique(np.abs(x[on])).size < 2:
-        return None
-    slope, intercept = np.polyfit(x[on] ** 2, p[on] ** 2, 1)
-    if not (intercept > 0 and slope < 0):
-        return None
-    p0, a = math.sqrt(intercept), math.sqrt(-intercept / slope)
-    fitted = p0 * np.sqrt(np.clip(1.0 - (x[on] / a) ** 2, 0.0, None))
-    return (p0, a) if np.max(np.abs(fitted - p[on])) <= 1e-6 * p0 else None
-
-
 def contact_extent(x, exact):
     """The largest |x| where the exact pressure is nonzero (NaN when it is zero everywhere)."""
     x, p = np.asarray(x, float), np.asarray(exact, float)
@@ -525,20 +509,20 @@ def contact_extent(x, exact):
     return float(np.max(np.abs(x[on]))) if on.any() else float("nan")
 
 
-def exact_pressure_curve(label, x, exact, x_max):
-    """The exact profile in mm and MPa up to x_max: Hertz's ellipse drawn densely when the
-    stored values lie on one (with its (p0, a)), else the stored values at the cell midpoints."""
-    ellipse = hertz_ellipse(x, exact)
-    if ellipse is None:
+def exact_pressure_curve(label, x, exact, x_max, p0=None, a=None):
+    """The exact profile in mm and MPa up to x_max: Hertz's ellipse p0 sqrt(1 - x^2/a^2)
+    drawn densely from the (p0, a) the results file holds for that time (returned with
+    it), else (no load, or a file written before it held them) the stored values at the
+    cell midpoints."""
+    if p0 is None or a is None or not (p0 > 0 and a > 0):
         keep = np.abs(x) <= x_max
         return figures.Curve(f"exact, {label}", x[keep] * 1e3, exact[keep] / 1e6), None
-    p0, a = ellipse
     theta = np.linspace(0.0, 0.5 * np.pi, 200)
     side = np.concatenate([a * np.sin(theta), [max(x_max, a)]])
     pressure = np.concatenate([p0 * np.cos(theta), [0.0]])
     if np.min(x) < 0:
         side, pressure = np.concatenate([-side[::-1], side]), np.concatenate([pressure[::-1], pressure])
-    return figures.Curve(f"Hertz at the load of {label}", side * 1e3, pressure / 1e6), ellipse
+    return figures.Curve(f"Hertz at the load of {label}", side * 1e3, pressure / 1e6), (p0, a)
 
 
 def contact_pressure_figure(study, all_series, directory):
@@ -569,7 +553,10 @@ def contact_pressure_figure(study, all_series, directory):
                 label += f" ({case.status}, {time_text(profile.time[-1])})"
             curves.append(figures.Curve(label, profile.x[keep] * 1e3, profile.pressure[-1][keep] / 1e6,
                                         styles[case.id]))
-        exact, ellipse = exact_pressure_curve(level_label(series, finest_case), finest.x, finest.exact[-1], x_max)
+        exact, ellipse = exact_pressure_curve(
+            level_label(series, finest_case), finest.x, finest.exact[-1], x_max,
+            None if finest.peak_pressure is None else finest.peak_pressure[-1],
+            None if finest.half_width is None else finest.half_width[-1])
         title, marks = series.label, []
         if ellipse is not None:
             p0, a = ellipse

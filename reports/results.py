@@ -524,6 +524,8 @@ class ContactPressure:
     time: np.ndarray              # T output times
     pressure: np.ndarray          # T x n simulated contact pressure [Pa]
     exact: np.ndarray             # T x n Hertz's pressure at the load the run measured [Pa]
+    peak_pressure: np.ndarray = None  # T: Hertz's p0 at that load [Pa] (None in files written before it)
+    half_width: np.ndarray = None     # T: Hertz's a at that load [m]
 
 
 @dataclass(frozen=True)
@@ -544,8 +546,11 @@ def read_contact_pressure(path):
         if time.size == 0 or x.size == 0:
             return None
         shape = (time.size, x.size)
+        exact = {name: np.asarray(group[f"exact_{name}"][:], float) for name in ("peak_pressure", "half_width")
+                 if f"exact_{name}" in group and group[f"exact_{name}"].shape == (time.size,)}
         return ContactPressure(x, time, np.asarray(group["pressure"][:], float).reshape(shape),
-                               np.asarray(group["exact_pressure"][:], float).reshape(shape))
+                               np.asarray(group["exact_pressure"][:], float).reshape(shape),
+                               exact.get("peak_pressure"), exact.get("half_width"))
 
 
 def read_scene_history(path):

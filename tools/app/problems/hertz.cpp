@@ -161,6 +161,7 @@ struct HertzRecord {
   std::vector<double> x;
   std::vector<double> time;
   std::vector<std::vector<double>> pressure, exact_pressure;
+  std::vector<double> peak_pressure_exact, half_width_exact;  // Hertz's p0 and a at each output's load (0 without)
   AxisReading axis;  // at the last output
 };
 
@@ -221,6 +222,8 @@ ProblemSetup setup(const Config& c) {
     record->time.push_back(t);
     record->pressure.push_back(r.pressure);
     record->exact_pressure.push_back(r.exact_pressure);
+    record->peak_pressure_exact.push_back(r.load > 0.0 ? r.hertz.peak_pressure() : 0.0);
+    record->half_width_exact.push_back(r.load > 0.0 ? r.hertz.half_width() : 0.0);
     const double nan = std::numeric_limits<double>::quiet_NaN();
     if (!(r.load > 0.0)) return std::vector<double>{nan, nan, nan, nan, nan};
     record->axis = read_axis(run.stepper.model().particles, spacing, r.hertz);
@@ -261,7 +264,8 @@ ProblemSetup setup(const Config& c) {
     g.set_attribute("description",
                     "pressure of the contact on the plate at each output time, at cell midpoints x: half the "
                     "vertical contact force of each bounding node column over the cell's width, and Hertz's "
-                    "p0 sqrt(1 - x^2 / a^2) at the load it sums to [Pa]");
+                    "p0 sqrt(1 - x^2 / a^2) at the load it sums to [Pa]; that p0 [Pa] and a [m] at each output "
+                    "time (exact_peak_pressure, exact_half_width; 0 where no load)");
     const std::size_t n = record->x.size(), T = record->time.size();
     std::vector<double> p, e;
     for (std::size_t k = 0; k < T; ++k) {
@@ -272,6 +276,8 @@ ProblemSetup setup(const Config& c) {
     g.write("time", record->time, {T});
     g.write("pressure", p, {T, n});
     g.write("exact_pressure", e, {T, n});
+    g.write("exact_peak_pressure", record->peak_pressure_exact, {T});
+    g.write("exact_half_width", record->half_width_exact, {T});
     h5::Group axis = probes.create_group("axis_stress");
     axis.set_attribute("description",
                        "stresses of the particles next to the axis at the last output time, by depth z below the "
