@@ -683,8 +683,9 @@ def health_figure(study, all_series, directory):
     path = directory / f"{slug(study, 'health')}.png"
     figures.save_png(figure, path)
     caption = (f"{study}: the run's health at each output time (/probes/monitors), one line per case. From the top: "
-               "the energy balance error, abs(energy_created) over the larger of the initial energy and the largest "
-               "abs(work) any one work_* term has done so far, the scale of the blow-up test (log scale); "
+               "the energy balance error, abs(energy_created) over energy_scale, the solver's scale of its blow-up "
+               "and health tests (the larger of the initial energy and the largest abs(work) any one work_* term "
+               "has done by then; log scale; absent from results files written before it); "
                "min J and max J over the particles (the lower and upper line of a case's colour), dotted at J = 0; "
                "the largest particle speed over its wave speed; the largest CPDI domain distortion (1: a square "
                "domain; log scale; none for linear MPM); where the results files have them, what lifts the signal "

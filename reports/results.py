@@ -576,11 +576,6 @@ def _time_columns(group):
     return time, columns
 
 
-# The work_* datasets of /probes/monitors (results-format.md, "/probes/monitors
-# (every scene)"), one value per output time: what the energy balance subtracts.
-WORK_COLUMNS = ("work_body_force", "work_constraints", "work_contact", "work_damping")
-
-
 @dataclass(frozen=True)
 class RunMonitors:
     initial_energy: float         # attribute initial_energy [J per unit depth; per radian in r-z]
@@ -601,24 +596,10 @@ def read_monitors(path):
         return None if read is None else RunMonitors(float(group.attrs.get("initial_energy", float("nan"))), *read)
 
 
-def energy_balance_scale(initial_energy, works):
-    """What the energy balance error is divided by at each output time: the larger
-    of the initial energy and the largest abs(work) any one work_* term has done
-    up to that time - the scale of the solver's blow-up test (results-format.md,
-    energy_created), so that a run stopped as `energy blow-up` plots above
-    energy_blowup_factor. The current kinetic and strain energy are left out on
-    purpose: a blow-up inflates them and would hide itself. The running maximum
-    is over output times (the solver keeps it over every step). NaN values are
-    passed over; NaN where nothing is finite or the scale is not positive.
-    works: one array per work_* term, each shaped like the output times."""
-    works = [np.asarray(w, float) for w in works]
-    parts = [np.full(works[0].shape, float(initial_energy))]
-    parts += [np.fmax.accumulate(np.abs(w)) for w in works]
-    scale = np.fmax.reduce(np.stack(parts), axis=0)     # fmax: a NaN loses to any number
-    return np.where(scale > 0, scale, np.nan)
-
-
 def relative_energy_created(monitors):
-    """abs(energy_created) over energy_balance_scale at each output time of a RunMonitors."""
-    scale = energy_balance_scale(monitors.initial_energy, [monitors.column(w) for w in WORK_COLUMNS])
+    """abs(energy_created) over the solver's energy_scale at each output time of a
+    RunMonitors (results-format.md): NaN where the file has no energy_scale (written
+    before it) or the scale is not positive."""
+    scale = monitors.column("energy_scale")
+    scale = np.where(scale > 0, scale, np.nan)
     return np.abs(monitors.column("energy_created")) / scale

@@ -3,7 +3,7 @@ per study from /probes/monitors (reports/results-format.md, "/probes/monitors"),
 one line per case, a failed case's failure time marked; left out for a study
 whose results files have no monitors (written before they existed), such as
 the stored gold directory; the energy balance error is divided by the scale
-results.energy_balance_scale defines."""
+the solver wrote (energy_scale)."""
 import json
 import shutil
 from pathlib import Path
@@ -15,7 +15,7 @@ import pytest
 import figures
 import report
 from conftest import record_calls, write_case_results
-from results import Case, CaseResults, RunMonitors, energy_balance_scale, relative_energy_created
+from results import Case, CaseResults, RunMonitors, relative_energy_created
 
 GOLD = Path(__file__).parent / "gold"
 INITIAL_ENERGY = 100.0
@@ -38,7 +38,7 @@ def synthetic_monitors(times, method, cells, failed=False):
     energy = INITIAL_ENERGY + sum(work.values()) + created
     distortion = {"cpdi": 1.0 + 0.5 * t, "gimp": 1.0 + 0.0 * t}.get(method, np.full(t.shape, np.nan))
     return {"time": t, "kinetic_energy": 0.6 * energy, "strain_energy": 0.4 * energy, **work,
-            "energy_created": created, "min_J": 1.0 - 0.1 * t, "max_J": 1.0 + 0.1 * t,
+            "energy_created": created, "energy_scale": np.fmax(INITIAL_ENERGY, 20.0 * t), "min_J": 1.0 - 0.1 * t, "max_J": 1.0 + 0.1 * t,
             "max_speed_over_wave_speed": 0.05 + 0.01 * t, "max_domain_distortion": distortion,
             "particles_near_edge": 0.0 * t}
 
@@ -127,28 +127,19 @@ def test_gold_without_monitors_has_no_health_figure(tmp_path, drawn):
     assert drawn == {}
 
 
-def test_energy_balance_scale_on_hand_made_arrays():
-    """Requirement: the scale is, at each output time, the larger of the initial
-    energy and the largest abs(work) any one work_* term has done up to then (the
-    solver's blow-up scale; the current kinetic + strain energy play no part);
-    NaN values are passed over; NaN when nothing is positive."""
-    kinetic = np.array([5.0, 20.0, 1.0, np.nan])
-    strain = np.array([5.0, 5.0, 1.0, np.nan])
-    works = [np.array([0.0, -12.0, 3.0, 4.0]),       # running max of abs: 0, 12, 12, 12
-             np.array([0.0, 1.0, 30.0, np.nan]),     # 0, 1, 30, 30
-             np.zeros(4),
-             np.array([0.0, -2.0, -3.0, -4.0])]      # 0, 2, 3, 4
-    # t0: the initial energy; t1: the body force's 12 (kinetic + strain, 25, do not count);
-    # t2, t3: the constraints' largest work so far
-    assert np.array_equal(energy_balance_scale(10.0, works), [10.0, 12.0, 30.0, 30.0])
-    assert np.isnan(energy_balance_scale(0.0, [np.zeros(2)])).all()
-
-    columns = dict(zip(("kinetic_energy", "strain_energy", "work_body_force", "work_constraints", "work_contact",
-                        "work_damping"), [kinetic, strain, *works]))
-    columns["energy_created"] = np.array([-1.0, 1.2, 3.0, np.nan])
-    monitors = RunMonitors(10.0, np.array([0.0, 1.0, 2.0, 3.0]), columns)
+def test_energy_balance_error_is_over_the_scale_the_solver_wrote():
+    """Requirement: the energy balance error is abs(energy_created) over the file's
+    energy_scale at each output time (the solver's blow-up and health scale; the
+    report forms no scale of its own); NaN where the scale is not positive, and at
+    every time for a file written before energy_scale."""
+    columns = {"energy_created": np.array([-1.0, 1.2, 3.0, np.nan, 1.0]),
+               "energy_scale": np.array([10.0, 12.0, 30.0, 30.0, 0.0]),
+               "work_body_force": np.array([0.0, -12.0, 3.0, 4.0, 5.0])}
+    monitors = RunMonitors(10.0, np.array([0.0, 1.0, 2.0, 3.0, 4.0]), columns)
     ratio = relative_energy_created(monitors)
-    assert np.allclose(ratio[:3], 0.1) and np.isnan(ratio[3])
+    assert np.allclose(ratio[:3], 0.1) and np.isnan(ratio[3]) and np.isnan(ratio[4])
+    del columns["energy_scale"]
+    assert np.isnan(relative_energy_created(RunMonitors(10.0, np.arange(5.0), columns))).all()
 
 
 def test_many_cases_draw_the_finest_failed_and_completed_of_each_method():

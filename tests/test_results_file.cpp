@@ -5,6 +5,7 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -84,6 +85,20 @@ TEST(ResultsFile, CompletedRunHoldsTheDocumentedLayout) {
   }
   const mpmvv::h5::Group point = probes.open_group("point_R1");
   EXPECT_EQ(dims_of(point, "time"), (std::vector<hsize_t>{hsize_t(root.attribute_int("steps"))}));
+
+  // The energy balance's scale at each output time: the larger of the initial
+  // energy and the largest abs(work) any one agent has done by the output
+  // times so far (the ring: the body force's work).
+  const mpmvv::h5::Group monitors = probes.open_group("monitors");
+  const std::vector<double> scale = monitors.read_doubles("energy_scale");
+  ASSERT_EQ(scale.size(), 2u);
+  double largest = monitors.attribute_double("initial_energy");
+  for (std::size_t k = 0; k < 2; ++k) {
+    for (const char* work : {"work_body_force", "work_constraints", "work_contact", "work_damping"})
+      largest = std::max(largest, std::abs(monitors.read_doubles(work)[k]));
+    EXPECT_EQ(scale[k], largest) << k;
+  }
+  EXPECT_GT(scale[1], monitors.attribute_double("initial_energy"));  // the force's work counts
 
   const mpmvv::h5::Group errors = root.open_group("errors");
   EXPECT_EQ(errors.read_doubles("time"), (std::vector<double>{0.1, 0.25}));

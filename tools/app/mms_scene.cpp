@@ -511,7 +511,9 @@ class MmsCase final : public SceneCase, private RunObserver {
     g.set_attribute("description",
                     "the run's health at each output time (solver/monitors.hpp): kinetic and strain energy, the work "
                     "done on the particles by body forces and tractions, node constraints, contact and damping, the "
-                    "energy made from nothing (kinetic + strain - initial - work), the angular momentum about the origin and the "
+                    "energy made from nothing (kinetic + strain - initial - work) and the scale the blow-up and "
+                    "health tests divide it by (the larger of the initial energy and the largest work yet done by any "
+                    "one agent, as of each output time), the angular momentum about the origin and the "
                     "exact motion's over the same particles [kg m^2/s per unit depth; NaN in r-z], J's range and that of J / J_exact (J_exact = 1 without an exact motion), the largest particle "
                     "speed over its wave speed, the largest CPDI domain distortion (1: square), particles at the "
                     "grid's edge, CPDI corner domains turned over, and what lifts the signal speed of the CFL step above the small-strain wave speed: "
@@ -531,6 +533,7 @@ class MmsCase final : public SceneCase, private RunObserver {
     column("work_contact", [](const MonitorRow& r) { return r.work.contact; });
     column("work_damping", [](const MonitorRow& r) { return r.work.damping; });
     column("energy_created", [](const MonitorRow& r) { return r.created; });
+    column("energy_scale", [](const MonitorRow& r) { return r.energy_scale; });
     column("angular_momentum", [](const MonitorRow& r) { return r.monitors.angular_momentum; });
     column("exact_angular_momentum", [](const MonitorRow& r) { return r.exact_angular_momentum; });
     column("min_J", [](const MonitorRow& r) { return r.monitors.min_J; });
