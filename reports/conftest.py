@@ -3,6 +3,7 @@ reports/results-format.md and synthetic suite output directories with the
 layout of suites/README.md, so the report, the gate and the tables are tested
 on data whose answer is known."""
 import json
+import tomllib
 
 import h5py
 import numpy as np
@@ -136,8 +137,10 @@ def write_suite_directory(directory, suite_toml, cases):
                                particle_positions=case.get("particle_positions"))
         (directory / "cases" / f"{case['id']}.json").write_text(json.dumps(entry))
         entries.append(entry)
+    # The [[expect]] tables as mpmvv suite records them (checked there; here taken as written).
+    expectations = tomllib.loads(suite_toml).get("expect", [])
     (directory / "manifest.json").write_text(json.dumps({"suite": "synthetic", "suite_file": "suites/synthetic.toml",
-                                                         "cases": entries}))
+                                                         "expectations": expectations, "cases": entries}))
     return directory
 
 

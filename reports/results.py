@@ -2,7 +2,8 @@
 the results files in it (reports/results-format.md).
 
     DIR/manifest.json        every case: id, study, resolved keys, status, results path
-    DIR/suite.toml           the suite as run: [[study]], [[expect]] and [[reference]] tables
+    DIR/suite.toml           the suite as run: [[study]] and [[reference]] tables (its [[expect]]
+                             as the manifest records them, checked)
     DIR/cases/<id>.h5        one results file per case that ran
 
 A case's status is the manifest's (completed, lost, failed, crashed, timeout,
@@ -100,7 +101,8 @@ class Suite:
     written: datetime
     has_suite_file: bool
     studies: list = field(default_factory=list)        # [[study]] tables of suite.toml
-    expectations: list = field(default_factory=list)   # [[expect]] tables of suite.toml
+    expectations: list = field(default_factory=list)   # [[expect]] tables, as the manifest records them checked
+    expectations_recorded: bool = True                 # False: a manifest written before it recorded them
     references: list = field(default_factory=list)     # [[reference]] tables of suite.toml (references.py)
     cases: list = field(default_factory=list)
 
@@ -127,11 +129,15 @@ def read_suite(directory):
     suite_path = directory / "suite.toml"
     suite_file = _read_suite_file(suite_path) if suite_path.is_file() else {}
     studies = suite_file.get("study", [])
-    expectations = suite_file.get("expect", [])
     references = suite_file.get("reference", [])
-    if not all(isinstance(tables, list) for tables in (studies, expectations, references)):
-        raise SuiteDirectoryError(f"{suite_path}: 'study', 'expect' and 'reference' must be arrays of tables "
-                                  "([[study]], [[expect]], [[reference]])")
+    if not all(isinstance(tables, list) for tables in (studies, references)):
+        raise SuiteDirectoryError(f"{suite_path}: 'study' and 'reference' must be arrays of tables "
+                                  "([[study]], [[reference]])")
+    # The expectations as mpmvv suite checked them (its loader is their one
+    # check: suites/README.md), not as suite.toml holds them.
+    expectations = manifest.get("expectations", [])
+    if not isinstance(expectations, list) or not all(isinstance(e, dict) for e in expectations):
+        raise SuiteDirectoryError(f"{manifest_path}: 'expectations' must be an array of objects")
     return Suite(
         directory=directory,
         name=str(manifest.get("suite", directory.name)),
@@ -140,6 +146,7 @@ def read_suite(directory):
         has_suite_file=suite_path.is_file(),
         studies=studies,
         expectations=expectations,
+        expectations_recorded="expectations" in manifest,
         references=references,
         cases=[_read_case(directory, entry) for entry in manifest["cases"]],
     )

@@ -572,6 +572,11 @@ Suite load_suite(const std::string& path) {
             throw ConfigError(fmt::format("{}: [[expect]]: study '{}' has no case with {} = {}", where_in(path, *l), name, refine, level));
         }
       }
+      // Checked: as the manifest records it for the gate and the report,
+      // which read it there and check nothing of it again.
+      std::ostringstream as_json;
+      as_json << toml::json_formatter{e};
+      suite.expectations.push_back(Json::parse(as_json.str()));
     }
   }
   check_references(top, path, study_keys, suite);
@@ -954,7 +959,8 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
     const Json head = {{"suite", suite.name},
                        {"suite_file", suite.file},
                        {"description", suite.description},
-                       {"written", stamp}};
+                       {"written", stamp},
+                       {"expectations", suite.expectations}};
     // Each value written by nlohmann, a case a line, so that a manifest of
     // hundreds of cases reads (and greps) case by case.
     std::string text = "{";

@@ -39,6 +39,9 @@ struct Suite {
   // again from t = 0.
   double checkpoint_seconds = 0.0;
   std::vector<SuiteCase> cases;
+  // The [[expect]] tables, each checked against the studies and their cases,
+  // as JSON (the manifest's "expectations": the gate's and the report's).
+  std::vector<Json> expectations;
   // What the loader found doubtful but not wrong, each with the file and line
   // (an expectation read where the exact signal is trivial).
   std::vector<std::string> warnings;
