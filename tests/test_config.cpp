@@ -1,7 +1,7 @@
 // Scene configuration against the real scene registry: a scene file and
 // `--set` overrides are checked before anything runs, and every mistake is
 // one ConfigError naming the file and line (or the override), the key and
-// the allowed range (STYLE.md principle 7).
+// the allowed range.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -180,7 +180,7 @@ TEST_F(SceneFile, ShippedRingSceneLoads) {
 }
 
 // The resolved configuration a run stores (to_toml) reads back to the same
-// values (STYLE.md principle 9).
+// values: every run keeps its full configuration.
 TEST_F(SceneFile, ResolvedConfigurationReadsBack) {
   const std::string path = write("ring.toml", "scene = \"ring\"\nmethod = \"linear\"\namplitude = 0.3\n");
   const Config original = load(path, {"cells=40", "output_times=0.125,0.5,1", "cfl=0.2"});
