@@ -10,8 +10,6 @@ Usage: /usr/bin/python3 reports/convergence_table.py RESULTS.h5 [RESULTS.h5 ...]
 """
 import sys
 
-import h5py
-
 from results import read_results_file
 from series import pair_order_cell
 
@@ -21,21 +19,21 @@ NORMS = {"L1 Theta=0": "L1_theta0", "L1 +45": "L1_theta_plus45", "L1 -45": "L1_t
 
 
 def read_case(path):
-    with h5py.File(path, "r") as f:
-        errors = f["errors"]
-        return {
-            "path": path,
-            "h": float(f.attrs["h"]),
-            "cells": int(f.attrs["cells"]),
-            "method": f.attrs["method"],
-            "status": f.attrs["status"],
-            "time_reached": float(f.attrs["time_reached"]),
-            "failure_reason": f.attrs["failure_reason"],
-            "wall": float(f.attrs["wall_time_s"]),
-            "time": list(errors["time"][:]),
-            "norms": {heading: list(errors[column][:]) for heading, column in NORMS.items()},
-            "case": read_results_file(path),
-        }
+    case = read_results_file(path)
+    attributes, errors = case.results.attributes, case.results.errors
+    return {
+        "path": path,
+        "h": float(attributes["h"]),
+        "cells": int(attributes["cells"]),
+        "method": attributes["method"],
+        "status": attributes["status"],
+        "time_reached": float(attributes["time_reached"]),
+        "failure_reason": attributes["failure_reason"],
+        "wall": float(attributes["wall_time_s"]),
+        "time": list(case.results.error_times),
+        "norms": {heading: list(errors[column]) for heading, column in NORMS.items()},
+        "case": case,
+    }
 
 
 def main(paths):

@@ -22,7 +22,7 @@ A reference names one or more studies, the scene keys that identify a row
 import math
 from dataclasses import dataclass
 
-from series import _canonical
+from series import canonical_value
 
 
 @dataclass(frozen=True)
@@ -68,7 +68,7 @@ def read_references(tables):
 
 def row_matches(keys, columns, values):
     """True when the case keys hold every column's value (1 equals 1.0)."""
-    return all(name in keys and _canonical(keys[name]) == _canonical(value) for name, value in zip(columns, values))
+    return all(name in keys and canonical_value(keys[name]) == canonical_value(value) for name, value in zip(columns, values))
 
 
 def row_label(columns, values):
@@ -79,7 +79,7 @@ def group_keys(cases, columns):
     """The keys that vary among a study's cases, other than the row's columns, in
     first-seen order: they tell apart the cases that match one row."""
     names = list(dict.fromkeys(name for c in cases for name in c.keys if name not in columns))
-    return [n for n in names if len({_canonical(c.keys.get(n)) for c in cases}) > 1]
+    return [n for n in names if len({canonical_value(c.keys.get(n)) for c in cases}) > 1]
 
 
 def reached_text(case):
@@ -101,7 +101,7 @@ def case_table(suite, reference, cell_of, published_header):
         cases = suite.cases_of(study)
         varying = group_keys(cases, reference.columns)
         for case in cases:
-            values = tuple(_canonical(case.keys.get(n)) for n in varying)
+            values = tuple(canonical_value(case.keys.get(n)) for n in varying)
             label = study + "".join(f" {n}={case.keys.get(n)}" for n in varying)
             if (study, values, label) not in groups:
                 groups.append((study, values, label))
@@ -113,7 +113,7 @@ def case_table(suite, reference, cell_of, published_header):
             cases = suite.cases_of(study)
             varying = group_keys(cases, reference.columns)
             match = [c for c in cases if row_matches(c.keys, reference.columns, values)
-                     and tuple(_canonical(c.keys.get(n)) for n in varying) == group]
+                     and tuple(canonical_value(c.keys.get(n)) for n in varying) == group]
             cells.append(cell_of(match[0]) if match else "-")
         rows.append(cells)
         css.append("")

@@ -83,7 +83,7 @@ def matches(keys, where):
     return all(name in keys and keys[name] == value for name, value in where.items())
 
 
-def _canonical(value):
+def canonical_value(value):
     """A hashable text for a key's value; 1 and 1.0 are the same value (a TOML echo may write either)."""
     return json.dumps(_as_float(value), sort_keys=True)
 
@@ -111,11 +111,11 @@ def refinement_series(cases, refine=DEFAULT_REFINE_KEY, named_first=()):
     if not cases:
         return []
     names = list(dict.fromkeys(name for c in cases for name in c.keys if name != refine))
-    varying = [n for n in names if len({_canonical(c.keys.get(n)) for c in cases}) > 1]
+    varying = [n for n in names if len({canonical_value(c.keys.get(n)) for c in cases}) > 1]
     grouping = [n for n in varying if not _follows(cases, n, refine)]
     groups = {}
     for case in cases:
-        groups.setdefault(tuple(_canonical(case.keys.get(n)) for n in grouping), []).append(case)
+        groups.setdefault(tuple(canonical_value(case.keys.get(n)) for n in grouping), []).append(case)
     rank = {name: index for index, name in enumerate(named_first)}
     ordered = sorted(grouping, key=lambda n: (rank.get(n, len(rank)), grouping.index(n)))
     named = []
@@ -130,15 +130,15 @@ def refinement_series(cases, refine=DEFAULT_REFINE_KEY, named_first=()):
 
 def _one_to_one(cases, a, b):
     """True when each value of key a goes with one value of key b and the reverse."""
-    pairs = {(_canonical(c.keys.get(a)), _canonical(c.keys.get(b))) for c in cases}
+    pairs = {(canonical_value(c.keys.get(a)), canonical_value(c.keys.get(b))) for c in cases}
     return len(pairs) == len({p[0] for p in pairs}) == len({p[1] for p in pairs})
 
 
 def _follows(cases, name, refine):
-    refine_values = {_canonical(c.keys[refine]) for c in cases}
+    refine_values = {canonical_value(c.keys[refine]) for c in cases}
     if len(refine_values) < 2:
         return False
-    return all(len({_canonical(c.keys.get(name)) for c in cases if _canonical(c.keys[refine]) == r}) == 1
+    return all(len({canonical_value(c.keys.get(name)) for c in cases if canonical_value(c.keys[refine]) == r}) == 1
                for r in refine_values)
 
 

@@ -14,52 +14,44 @@ import argparse
 import sys
 from collections import defaultdict
 
-import h5py
-
 from results import read_results_file
 from series import pair_order_cell
 
 METHOD_ORDER = {"linear": 0, "gimp": 1, "cpdi": 2, "cpdi-exact": 3, "bspline": 4, "bspline-cubic": 5}
 
 
-def text(value):
-    return value.decode() if isinstance(value, bytes) else str(value)
-
-
 def read_case(path, times, norms):
-    with h5py.File(path, "r") as f:
-        errors = f["errors"]
-        recorded = list(errors["time"][:])
-        columns = [name for name in errors.keys() if name != "time"]
-        chosen = norms or [columns[0], "particle_L2"]
-        wanted = times or [float(f.attrs["end_time"])]
-        values = {}
-        for norm in chosen:
-            series = list(errors[norm][:]) if norm in errors else []
-            for t in wanted:
-                hits = [k for k, r in enumerate(recorded) if abs(r - t) < 1e-12 * max(1.0, abs(t))]
-                values[(norm, t)] = series[hits[0]] if hits and hits[0] < len(series) else float("nan")
-        attrs = f.attrs
-        return {
-            "scene": text(attrs["scene"]) if "scene" in attrs else "ring",
-            # None, not NaN, for a scene without one: NaN would make every file a group of its own.
-            "amplitude": float(attrs["amplitude"]) if "amplitude" in attrs else None,
-            "variant": text(attrs["variant"]) if "variant" in attrs else "",
-            "extra": f"R_i={float(attrs['inner_radius']):g}" if text(attrs.get("scene", "")) == "rz-cylinder" else "",
-            "method": text(attrs["method"]),
-            "cells": int(attrs["cells"]),
-            "ppd": int(attrs["particles_per_direction"]),
-            "h": float(attrs["h"]),
-            "status": text(attrs["status"]),
-            "reason": text(attrs["failure_reason"]),
-            "failure_time": float(attrs["failure_time"]),
-            "wall": float(attrs["wall_time_s"]),
-            "forcing": float(attrs["forcing_time_s"]) if "forcing_time_s" in attrs else float("nan"),
-            "steps": int(attrs["steps"]),
-            "columns": [(norm, t) for norm in chosen for t in wanted],
-            "values": values,
-            "case": read_results_file(path),
-        }
+    case = read_results_file(path)
+    attrs, errors = case.results.attributes, case.results.errors
+    recorded = list(case.results.error_times)
+    chosen = norms or [next(iter(errors)), "particle_L2"]
+    wanted = times or [float(attrs["end_time"])]
+    values = {}
+    for norm in chosen:
+        series = list(errors.get(norm, []))
+        for t in wanted:
+            hits = [k for k, r in enumerate(recorded) if abs(r - t) < 1e-12 * max(1.0, abs(t))]
+            values[(norm, t)] = series[hits[0]] if hits and hits[0] < len(series) else float("nan")
+    return {
+        "scene": str(attrs.get("scene", "ring")),
+        # None, not NaN, for a scene without one: NaN would make every file a group of its own.
+        "amplitude": float(attrs["amplitude"]) if "amplitude" in attrs else None,
+        "variant": str(attrs.get("variant", "")),
+        "extra": f"R_i={float(attrs['inner_radius']):g}" if attrs.get("scene") == "rz-cylinder" else "",
+        "method": str(attrs["method"]),
+        "cells": int(attrs["cells"]),
+        "ppd": int(attrs["particles_per_direction"]),
+        "h": float(attrs["h"]),
+        "status": str(attrs["status"]),
+        "reason": str(attrs["failure_reason"]),
+        "failure_time": float(attrs["failure_time"]),
+        "wall": float(attrs["wall_time_s"]),
+        "forcing": float(attrs.get("forcing_time_s", float("nan"))),
+        "steps": int(attrs["steps"]),
+        "columns": [(norm, t) for norm in chosen for t in wanted],
+        "values": values,
+        "case": case,
+    }
 
 
 def order_cell(coarse, fine, key):
