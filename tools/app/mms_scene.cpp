@@ -126,6 +126,25 @@ std::vector<Vec2> points_on_segment(const Vec2& a, const Vec2& b, int count) {
   return out;
 }
 
+void ProblemSetup::body_is_rectangle(const Vec2& lower, const Vec2& upper) {
+  contains = [lower, upper](const Vec2& X) {
+    return X.x() >= lower.x() && X.x() <= upper.x() && X.y() >= lower.y() && X.y() <= upper.y();
+  };
+#ifdef MPMVV_HAVE_CGAL
+  body = Body::rectangle(lower, upper);
+#endif
+}
+
+void ProblemSetup::body_is_annulus(double inner_radius, double outer_radius) {
+  contains = [inner_radius, outer_radius](const Vec2& X) {
+    const double R = X.norm();
+    return R >= inner_radius && R <= outer_radius;
+  };
+#ifdef MPMVV_HAVE_CGAL
+  body = Body::annulus(Vec2::Zero(), inner_radius, outer_radius);
+#endif
+}
+
 namespace {
 
 using std::numbers::pi;

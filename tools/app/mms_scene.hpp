@@ -80,6 +80,10 @@ struct ProblemSetup {
 #ifdef MPMVV_HAVE_CGAL
   std::optional<Body> body;                    // the same body, exactly (seeding = "exact")
 #endif
+  // A body described once: `contains` for every build and, with CGAL, the
+  // exact `body`, the same region.
+  void body_is_rectangle(const Vec2& lower, const Vec2& upper);
+  void body_is_annulus(double inner_radius, double outer_radius);  // about the origin
   std::vector<ProbeLine> lines;
   std::vector<ProbePoint> points;
   std::optional<ProbeCircle> circle;

@@ -69,10 +69,7 @@ ProblemSetup setup(const Config& c) {
   // L (not a sum of cells, which rounds) so that probes on its sides belong to it.
   s.grid = GridGeometry::walled(Vec2::Zero(), L / cells, cells, one_d ? 2 : cells);
   const double height = one_d ? 2.0 * L / cells : L;
-  s.contains = [L, height](const Vec2& X) { return X.x() >= 0.0 && X.x() <= L && X.y() >= 0.0 && X.y() <= height; };
-#ifdef MPMVV_HAVE_CGAL
-  s.body = Body::rectangle(Vec2::Zero(), Vec2(L, height));
-#endif
+  s.body_is_rectangle(Vec2::Zero(), Vec2(L, height));
 
   const int n = int(c.integer("probe_points"));
   const double middle_y = 0.5 * height;

@@ -76,13 +76,7 @@ ProblemSetup setup(const Config& c) {
                                    "{} m domain (h = {:.4g} m)", reach, domain, s.grid.h));
   if (ro - ri < s.grid.h)
     c.reject("cells", fmt::format("the ring is {} m wide but a cell is {:.4g} m: use more cells", ro - ri, s.grid.h));
-  s.contains = [ri, ro](const Vec2& X) {
-    const double R = X.norm();
-    return R >= ri && R <= ro;
-  };
-#ifdef MPMVV_HAVE_CGAL
-  s.body = Body::annulus(Vec2::Zero(), ri, ro);
-#endif
+  s.body_is_annulus(ri, ro);
   const int n = int(c.integer("probe_points"));
   const double angles[3] = {0.0, pi / 4.0, -pi / 4.0};
   const char* names[3] = {"theta0", "theta_plus45", "theta_minus45"};

@@ -191,10 +191,7 @@ ProblemSetup setup(const Config& c) {
   const int cells = int(c.integer("cells"));
   const double h = D / cells;
   s.grid = GridGeometry::walled(Vec2(0.0, -D), h, int(std::ceil(W / h - 1e-9)) + 3, cells + 4);
-  s.contains = [W, D](const Vec2& X) { return X.x() >= 0.0 && X.x() <= W && X.y() >= -D && X.y() <= 0.0; };
-#ifdef MPMVV_HAVE_CGAL
-  s.body = Body::rectangle(Vec2(0.0, -D), Vec2(W, 0.0));
-#endif
+  s.body_is_rectangle(Vec2(0.0, -D), Vec2(W, 0.0));
   s.loading = fmt::format("rigid disk R = {} m moved {} m into the plate, frictionless contact; bottom clamped; "
                           "grid damping",
                           R, delta);

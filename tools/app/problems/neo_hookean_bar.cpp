@@ -77,10 +77,7 @@ ProblemSetup setup(const Config& c) {
   const double spacing = h / ppd;
   s.grid = GridGeometry::walled(Vec2::Zero(), h, int(std::ceil(std::max(1.0, l1) * cells)) + 4,
                                 int(std::ceil(std::max(1.0, l2) * half / h)) + 4);
-  s.contains = [L, half](const Vec2& X) { return X.x() >= 0.0 && X.x() <= L && X.y() >= 0.0 && X.y() <= half; };
-#ifdef MPMVV_HAVE_CGAL
-  s.body = Body::rectangle(Vec2::Zero(), Vec2(L, half));
-#endif
+  s.body_is_rectangle(Vec2::Zero(), Vec2(L, half));
   const bool platen = l1 < 1.0;
   s.loading = platen ? fmt::format("rigid platen moved from x = L to {} L, frictionless contact, grid damping", l1)
                      : fmt::format("dead load {:.9g} N/m per unit reference height on the end x = L, grid damping",

@@ -73,13 +73,7 @@ ProblemSetup setup(const Config& c) {
                                   p.outer_radius - p.inner_radius, s.grid.h));
 
   s.solution = mms::make_solution(mms::RingMotion{p}, s.material, p.density, s.geometry);
-  s.contains = [p](const Vec2& X) {
-    const double R = X.norm();
-    return R >= p.inner_radius && R <= p.outer_radius;
-  };
-#ifdef MPMVV_HAVE_CGAL
-  s.body = Body::annulus(Vec2::Zero(), p.inner_radius, p.outer_radius);
-#endif
+  s.body_is_annulus(p.inner_radius, p.outer_radius);
   const int n = int(c.integer("probe_points"));
   const double angles[3] = {0.0, pi / 4.0, -pi / 4.0};
   const char* names[3] = {"theta0", "theta_plus45", "theta_minus45"};

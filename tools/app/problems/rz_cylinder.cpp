@@ -57,10 +57,7 @@ ProblemSetup setup(const Config& c) {
   s.grid = GridGeometry::walled(Vec2::Zero(), h, int(std::ceil((reach + 2.0 * h) / h)), cells);
   if (ro - ri < h)
     c.reject("cells", fmt::format("the wall is {} m thick but a cell is {:.4g} m: use more cells", ro - ri, h));
-  s.contains = [ri, ro, H](const Vec2& X) { return X.x() >= ri && X.x() <= ro && X.y() >= 0.0 && X.y() <= H; };
-#ifdef MPMVV_HAVE_CGAL
-  s.body = Body::rectangle(Vec2(ri, 0.0), Vec2(ro, H));
-#endif
+  s.body_is_rectangle(Vec2(ri, 0.0), Vec2(ro, H));
 
   const int n = int(c.integer("probe_points"));
   const double middle = 0.5 * (ri + ro);

@@ -65,10 +65,7 @@ ProblemSetup setup(const Config& c) {
   const double h = H / cells;
   const int across = int(std::ceil(W / h - 1e-9));
   s.grid = GridGeometry::walled(Vec2(-3.0 * h, 0.0), h, across + 6, cells + 3);
-  s.contains = [W, H](const Vec2& X) { return X.x() >= 0.0 && X.x() <= W && X.y() >= 0.0 && X.y() <= H; };
-#ifdef MPMVV_HAVE_CGAL
-  s.body = Body::rectangle(Vec2::Zero(), Vec2(W, H));
-#endif
+  s.body_is_rectangle(Vec2::Zero(), Vec2(W, H));
   s.loading = fmt::format("bottom clamped, top moved by {} m along x (prescribed node motion), grid damping", shift);
   const double ramp_time = qs.ramp_time, damping = qs.damping;
   s.stages = [H, shift, ramp_time, damping](const Particles&, const GridGeometry& grid) {

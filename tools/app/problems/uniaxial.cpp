@@ -79,10 +79,7 @@ ProblemSetup setup(const Config& c) {
   const double h = L / cells;
   const int rows = int(std::ceil(half / h - 1e-9)) + 3;
   s.grid = GridGeometry::walled(Vec2::Zero(), h, cells + 3, rows);
-  s.contains = [L, half](const Vec2& X) { return X.x() >= 0.0 && X.x() <= L && X.y() >= 0.0 && X.y() <= half; };
-#ifdef MPMVV_HAVE_CGAL
-  s.body = Body::rectangle(Vec2::Zero(), Vec2(L, half));
-#endif
+  s.body_is_rectangle(Vec2::Zero(), Vec2(L, half));
   s.loading = fmt::format("grip at x = L moved by {} m (prescribed node motion), grid damping", delta);
   const double ramp_time = qs.ramp_time, damping = qs.damping;
   s.stages = [L, delta, ramp_time, damping](const Particles&, const GridGeometry& grid) {

@@ -16,10 +16,7 @@ void set_up_vibrating_strip(ProblemSetup& s, double length, int cells, int probe
   const double h = L / cells;
   s.grid = GridGeometry::walled(Vec2::Zero(), h, cells + 4, 2);
   const double height = 2.0 * h;
-  s.contains = [L, height](const Vec2& X) { return X.x() >= 0.0 && X.x() <= L && X.y() >= 0.0 && X.y() <= height; };
-#ifdef MPMVV_HAVE_CGAL
-  s.body = Body::rectangle(Vec2::Zero(), Vec2(L, height));
-#endif
+  s.body_is_rectangle(Vec2::Zero(), Vec2(L, height));
   ProbeLine line{"line_axis", ProbeQuantity::displacement_x, "reference_x", {}, {}, std::nullopt};
   line.reference = points_on_segment(Vec2(0.0, 0.5 * height), Vec2(L, 0.5 * height), probe_points);
   for (const Vec2& X : line.reference) line.parameter.push_back(X.x());
