@@ -143,12 +143,19 @@ TEST_F(Cli, DescribeListsResolvedKeys) {
 
 // ---------------------------------------------------------------- mpmvv mms
 
-// `mms list` exits 0 and names the four manufactured solutions.
+// `mms list` exits 0 and lists the four manufactured solutions with their
+// parameters; the scenes whose exact solution needs no force (Hertz, the
+// bars) are named on one line after them, not listed as manufactured.
 TEST_F(Cli, MmsListNamesTheSolutions) {
   const Outcome o = mpmvv("mms list");
   EXPECT_EQ(o.status, 0) << o.err;
   for (const char* name : {"ring:", "axis-aligned:", "expanding-ring:", "rz-cylinder:"})
     EXPECT_NE(o.out.find(name), std::string::npos) << name << "\n" << o.out;
+  EXPECT_EQ(o.out.find("hertz-cylinder:"), std::string::npos) << o.out;
+  const auto exact = o.out.find("exact solutions without a manufactured force");
+  ASSERT_NE(exact, std::string::npos) << o.out;
+  for (const char* name : {"hertz-cylinder", "vibrating-bar", "uniaxial-tension"})
+    EXPECT_NE(o.out.find(name, exact), std::string::npos) << name << "\n" << o.out;
   EXPECT_EQ(o.err, "");
 }
 

@@ -37,9 +37,16 @@ nlohmann::ordered_json json_of(const Mat2& m) { return {{m(0, 0), m(0, 1)}, {m(1
 
 }  // namespace
 
+// The scenes whose exact solution moves under a manufactured body force,
+// with their parameters; then, by name, the scenes whose exact solution needs
+// none (eval and check take those too; `mpmvv scenes` lists every scene).
 std::string mms_list() {
-  std::string s;
+  std::string s, exact_only;
   for (const MmsProblem& p : mms_problems()) {
+    if (setup_for(p, {}).force_free) {
+      exact_only += (exact_only.empty() ? "" : ", ") + p.name;
+      continue;
+    }
     s += fmt::format("{}: {}\n", p.name, p.summary);
     for (const KeySpec& k : p.keys()) {
       // The solver's keys belong to runs, not to the solution.
@@ -49,6 +56,10 @@ std::string mms_list() {
       s += fmt::format("  {:<16} default {:<14} {}\n", k.name, format_value(k.default_value), k.help);
     }
   }
+  if (!exact_only.empty())
+    s += fmt::format("exact solutions without a manufactured force (mms eval and mms check take them too; "
+                     "mpmvv scenes lists every scene): {}\n",
+                     exact_only);
   return s;
 }
 
