@@ -115,6 +115,9 @@ TEST(SuiteFile, MistakesNameFileLineAndKey) {
       {study + "sweep = { cells = [32, 64] }\n[[expect]]\nstudy = \"a\"\nnorm = \"L1_theta0\"\nmax_error = 1.0\n"
                "interval_within_band = true\n",
        "'interval_within_band' needs an 'order'"},
+      {study + "sweep = { cells = [32, 64] }\n[[expect]]\nstudy = \"a\"\nnorm = \"L1_theta0\"\norder = nan\n"
+               "tolerance = 0.1\n",
+       "[[expect]] holds a value that is not a finite number (nan or inf)"},
       {study + "sweep = { cells = [32, 64] }\n[[expect]]\nstudy = \"a\"\nnorm = \"L1_theta0\"\norder = 2\n"
                "tolerance = 0.1\ninterval_within_band = 1\n",
        "'interval_within_band' must be true or false"},

@@ -173,6 +173,21 @@ std::vector<Axis> axes_of(const toml::table& table, const std::string& file, con
   return axes;
 }
 
+// The first floating-point value in `node` (a table, an array or a value)
+// that is not finite, which JSON cannot hold (toml++ writes it as a string).
+const toml::node* non_finite(const toml::node& node) {
+  if (const toml::table* t = node.as_table()) {
+    for (const auto& [k, v] : *t)
+      if (const toml::node* n = non_finite(v)) return n;
+  } else if (const toml::array* a = node.as_array()) {
+    for (const toml::node& v : *a)
+      if (const toml::node* n = non_finite(v)) return n;
+  } else if (const auto* f = node.as_floating_point()) {
+    if (!std::isfinite(f->get())) return &node;
+  }
+  return nullptr;
+}
+
 Json json_of(const Value& v) {
   return std::visit([](const auto& x) { return Json(x); }, v);
 }
@@ -576,7 +591,11 @@ Suite load_suite(const std::string& path) {
       // which read it there and check nothing of it again.
       std::ostringstream as_json;
       as_json << toml::json_formatter{e};
-      suite.expectations.push_back(Json::parse(as_json.str()));
+      if (const toml::node* bad = non_finite(e))
+        throw ConfigError(fmt::format("{}: [[expect]] holds a value that is not a finite number (nan or inf)",
+                                      where_in(path, *bad)));
+      Json recorded = Json::parse(as_json.str());
+      suite.expectations.push_back(std::move(recorded));
     }
   }
   check_references(top, path, study_keys, suite);
