@@ -14,6 +14,8 @@ import pytest
 
 import gate
 import report
+import report_rows
+import report_tables
 from conftest import (RING_TIMES, ROUNDOFF_SUITE, SYNTHETIC_SUITE, roundoff_cases, synthetic_ring_cases,
                       write_suite_directory)
 from results import error_scale, read_suite, settling_scale
@@ -246,7 +248,7 @@ def test_a_lost_case_is_not_completed_anywhere(tmp_path, capsys):
     assert at_end[32].reason == "" and at_end[128].reason == ""
     early = {l.value: l for l in series_levels(cpdi, "L1_theta0", 0.25)}
     assert early[64].reason == "" and early[64].error == pytest.approx(0.5 * (3.0 / 64) ** 2 * 0.25, rel=1e-12)
-    table = report.case_table(suite)
+    table = report_tables.case_table(suite)
     cells = next(r for r in table.rows if r[0] == "ring-method=cpdi-cells=64")
     assert cells[1] == "lost" and "health_J_factor" in cells[3]
 
@@ -497,10 +499,10 @@ def test_an_order_at_the_settling_level_fails_and_says_so(tmp_path, capsys):
         "leave up to 1.5 times the error") in rows["4"]
     assert "PASS" in rows["5"] and "2.000 [2.00, 2.00]" in rows["5"]
     # The report's orders table gives the series the same class, and no order.
-    [row] = [r for r in report.order_rows(read_suite(directory))
+    [row] = [r for r in report_rows.order_rows(read_suite(directory))
              if r.study == "small" and r.norm == "particle_L2" and r.at_end]
     assert row.classification == "settling" and not row.has_order
-    assert "the settling level at cells=64" in report.order_cells(row)[-1]
+    assert "the settling level at cells=64" in report_tables.order_cells(row)[-1]
 
     _settle(directory, "small-cells=64", method="newton", displacement=1e-16, strain=0.0)
     for cells in (64, 128):

@@ -14,6 +14,7 @@ import pytest
 
 import figures
 import report
+import scene_figures
 from conftest import record_calls, write_case_results
 from results import Case, CaseResults, RunMonitors, relative_energy_created
 
@@ -143,7 +144,7 @@ def test_energy_balance_error_is_over_the_scale_the_solver_wrote():
 
 
 def test_many_cases_draw_the_finest_failed_and_completed_of_each_method():
-    """Requirement: with more than report.HEALTH_MAX_CASES cases the figure draws, per
+    """Requirement: with more than scene_figures.HEALTH_MAX_CASES cases the figure draws, per
     method, the finest completed case and the finest case that did not complete."""
     def case(method, cells, status="completed"):
         results = CaseResults({"h": 1.0 / cells, "status": status}, np.zeros(0), {}, {})
@@ -151,15 +152,15 @@ def test_many_cases_draw_the_finest_failed_and_completed_of_each_method():
                     results=results)
     cases = [case(m, n, "failed" if (m, n) == ("linear", 256) else "completed")
              for m in ("linear", "cpdi") for n in (8, 16, 32, 64, 128, 256, 512)]
-    chosen, selected = report.health_selection(cases)
+    chosen, selected = scene_figures.health_selection(cases)
     assert selected and [c.id for c in chosen] == ["linear-256", "linear-512", "cpdi-512"]
     # many failures: only the finest of them per method
     failing = [case(m, n, "failed" if n >= 64 else "completed")
                for m in ("linear", "gimp") for n in (8, 16, 32, 64, 128, 256, 512)]
-    chosen, selected = report.health_selection(failing)
+    chosen, selected = scene_figures.health_selection(failing)
     assert selected and [c.id for c in chosen] == ["linear-32", "linear-512", "gimp-32", "gimp-512"]
-    few, selected = report.health_selection(cases[:report.HEALTH_MAX_CASES])
-    assert not selected and len(few) == report.HEALTH_MAX_CASES
+    few, selected = scene_figures.health_selection(cases[:scene_figures.HEALTH_MAX_CASES])
+    assert not selected and len(few) == scene_figures.HEALTH_MAX_CASES
 
 
 @needs_gold

@@ -14,6 +14,8 @@ import pytest
 import figures
 import gate
 import report
+import report_rows
+import report_tables
 from conftest import (HERTZ_END_TIME, HERTZ_SUITE, ROUNDOFF_SUITE, SYNTHETIC_SUITE, hertz_cases, hertz_exact_pressure,
                       hertz_half_width, hertz_load, record_calls, roundoff_cases, synthetic_ring_cases,
                       write_suite_directory)
@@ -255,7 +257,7 @@ def test_measurements_table_lists_every_attribute_per_case(tmp_path):
     assert "| mesh-cells=25 | - | - | - | - |" in markdown and "| mesh-cells=200 | - | - | - | - |" in markdown
     page = written["html"].read_text()
     assert "<h2>Measurements: mesh</h2>" in page and f"<td>{hertz_load(100):.4g}</td>" in page
-    assert report.measurement_text(0.015854621348) == "0.01585" and report.measurement_text(2.2454e7) == "2.245e+07"
+    assert report_tables.measurement_text(0.015854621348) == "0.01585" and report_tables.measurement_text(2.2454e7) == "2.245e+07"
 
 
 REFERENCE_TABLES = """
@@ -364,6 +366,6 @@ def test_grid_convergence_of_changes_at_round_off_has_no_order(tmp_path):
     cases = read_suite(directory).cases_of("roundoff")         # 100 steps each
     point = PointHistory("p", "displacement_x", np.array([0.6, 0.8]), np.zeros(1), np.zeros(1), np.zeros(1))
     floor = 356 * 2.220446049250313e-16 * 1.0
-    assert report.point_changes_at_roundoff(cases, point, (1e-6, 1e-6 + 0.5 * floor, 1e-6 + 0.75 * floor))
-    assert not report.point_changes_at_roundoff(cases, point, (1e-6, 1e-6 + 4 * floor, 1e-6 + 6 * floor))
+    assert report_rows.point_changes_at_roundoff(cases, point, (1e-6, 1e-6 + 0.5 * floor, 1e-6 + 0.75 * floor))
+    assert not report_rows.point_changes_at_roundoff(cases, point, (1e-6, 1e-6 + 4 * floor, 1e-6 + 6 * floor))
 
