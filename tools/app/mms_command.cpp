@@ -7,8 +7,8 @@
 
 #include <fmt/format.h>
 #include <fmt/ostream.h>
-#include <nlohmann/json.hpp>
 
+#include "json.hpp"
 #include "mms_scene.hpp"
 
 namespace mpmvv::app {
@@ -32,8 +32,8 @@ ProblemSetup setup_for(const MmsProblem& problem, const std::vector<std::string>
   return problem.setup(config);
 }
 
-nlohmann::ordered_json json_of(const Vec2& v) { return {v.x(), v.y()}; }
-nlohmann::ordered_json json_of(const Mat2& m) { return {{m(0, 0), m(0, 1)}, {m(1, 0), m(1, 1)}}; }
+Json json_of(const Vec2& v) { return {v.x(), v.y()}; }
+Json json_of(const Mat2& m) { return {{m(0, 0), m(0, 1)}, {m(1, 0), m(1, 1)}}; }
 
 }  // namespace
 
@@ -83,23 +83,23 @@ int mms_eval(const MmsEvalRequest& r, std::ostream& out, std::ostream& err) {
   const bool rz = setup.geometry == Geometry::axisymmetric;
   if (r.json) {
     // Doubles to their shortest exact text; a NaN or an infinity as null.
-    const nlohmann::ordered_json j = {{"solution", r.name},
-                                      {"geometry", to_string(setup.geometry)},
-                                      {"reference_position", json_of(X)},
-                                      {"time", r.time},
-                                      {"position", json_of(f.position)},
-                                      {"displacement", json_of(f.displacement)},
-                                      {"velocity", json_of(f.velocity)},
-                                      {"acceleration", json_of(f.acceleration)},
-                                      {"F", json_of(f.deformation_gradient)},
-                                      {"F33", f.hoop_stretch},
-                                      {"J", f.J},
-                                      {"cauchy_stress", json_of(f.cauchy_stress)},
-                                      {"cauchy_stress_33", f.cauchy_stress_33},
-                                      {"first_piola", json_of(f.first_piola)},
-                                      {"first_piola_33", f.first_piola_33},
-                                      {"body_force", json_of(f.body_force)}};
-    fmt::print(out, "{}\n", j.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace));
+    const Json j = {{"solution", r.name},
+                    {"geometry", to_string(setup.geometry)},
+                    {"reference_position", json_of(X)},
+                    {"time", r.time},
+                    {"position", json_of(f.position)},
+                    {"displacement", json_of(f.displacement)},
+                    {"velocity", json_of(f.velocity)},
+                    {"acceleration", json_of(f.acceleration)},
+                    {"F", json_of(f.deformation_gradient)},
+                    {"F33", f.hoop_stretch},
+                    {"J", f.J},
+                    {"cauchy_stress", json_of(f.cauchy_stress)},
+                    {"cauchy_stress_33", f.cauchy_stress_33},
+                    {"first_piola", json_of(f.first_piola)},
+                    {"first_piola_33", f.first_piola_33},
+                    {"body_force", json_of(f.body_force)}};
+    fmt::print(out, "{}\n", json_text(j));
     return 0;
   }
   const char* third = rz ? "theta" : "zz";

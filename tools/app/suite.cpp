@@ -589,13 +589,12 @@ Suite load_suite(const std::string& path) {
       }
       // Checked: as the manifest records it for the gate and the report,
       // which read it there and check nothing of it again.
-      std::ostringstream as_json;
-      as_json << toml::json_formatter{e};
       if (const toml::node* bad = non_finite(e))
         throw ConfigError(fmt::format("{}: [[expect]] holds a value that is not a finite number (nan or inf)",
                                       where_in(path, *bad)));
-      Json recorded = Json::parse(as_json.str());
-      suite.expectations.push_back(std::move(recorded));
+      std::ostringstream as_json;
+      as_json << toml::json_formatter{e};
+      suite.expectations.push_back(Json::parse(as_json.str()));
     }
   }
   check_references(top, path, study_keys, suite);
@@ -629,12 +628,6 @@ Json case_json(const SuiteCase& c, const CaseState& s, const std::string& result
           {"exit_code", s.exit_code},
           {"wall_time_s", s.wall},
           {"detail", s.detail}};
-}
-
-// JSON's text: a NaN or an infinity is written null, and bytes that are not
-// UTF-8 (a solver's message) as U+FFFD, so the file always parses.
-std::string json_text(const Json& j, int indent = -1) {
-  return j.dump(indent, ' ', false, Json::error_handler_t::replace);
 }
 
 // Member `key` of object j where it holds a T, else `fallback`.

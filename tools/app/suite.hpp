@@ -9,13 +9,9 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
+#include "json.hpp"
 
 namespace mpmvv::app {
-
-// The manifest's and the case files' JSON, its objects' members in the order
-// written.
-using Json = nlohmann::ordered_json;
 
 // One run of a scene: the key=value overrides that make it, in order.
 struct SuiteCase {
