@@ -23,7 +23,7 @@
 #include "solver/io/hdf5.hpp"
 #include "suite_support.hpp"
 #include "tools/app/config.hpp"
-#include "tools/app/suite.hpp"
+#include "tools/app/suite/suite.hpp"
 
 namespace {
 

@@ -1,4 +1,5 @@
 #include "config.hpp"
+#include "toml_file.hpp"
 
 #include <toml++/toml.h>
 
@@ -254,13 +255,7 @@ Config load_scene_file(const std::string& path,
                        const std::function<std::optional<std::vector<KeySpec>>(const std::string&)>& specs_for_scene,
                        const std::vector<std::string>& overrides) {
   if (!std::filesystem::exists(path)) throw ConfigError(fmt::format("{}: no such scene file", path));
-  toml::table table;
-  try {
-    table = toml::parse_file(path);
-  } catch (const toml::parse_error& e) {
-    throw ConfigError(fmt::format("{}:{}:{}: TOML syntax error: {}", path, e.source().begin.line,
-                                  e.source().begin.column, e.description()));
-  }
+  const toml::table table = parse_toml_file(path);
   auto where = [&](const toml::node& n) { return fmt::format("{}:{}", path, n.source().begin.line); };
 
   const toml::node* scene_node = table.get("scene");

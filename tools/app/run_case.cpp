@@ -26,7 +26,7 @@
 #include "scene.hpp"
 #include "solver/parallel.hpp"
 #include "solver/time_loop.hpp"
-#include "suite.hpp"
+#include "suite/suite.hpp"
 
 namespace mpmvv::app {
 

@@ -9,7 +9,7 @@
 
 #include "tools/app/config.hpp"
 #include "tools/app/mms_command.hpp"
-#include "tools/app/suite.hpp"
+#include "tools/app/suite/suite.hpp"
 #include "tools/app/run_case.hpp"
 
 namespace {

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "json.hpp"
+#include "tools/app/json.hpp"
 
 namespace mpmvv::app {
 

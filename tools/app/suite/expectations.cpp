@@ -1,0 +1,121 @@
+#include "expectations.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "toml_values.hpp"
+
+namespace mpmvv::app::suite_file {
+
+namespace {
+
+// Below this fraction of its largest over the output times, the exact signal
+// an expectation reads measures little: a run without the motion would score
+// nearly the same there (reports/gate.py: TRIVIAL_SIGNAL, the same rule after
+// the run).
+constexpr double kTrivialSignal = 0.05;
+
+// A warning when expectation `e` reads its norm where the exact signal is
+// trivial, judged on the first case of its study (the levels of a study share
+// the motion).
+void warn_of_a_trivial_read(const toml::table& e, const std::string& here, const SceneCase& scene,
+                            std::vector<std::string>& warnings) {
+  const std::string norm = e.get("norm")->as_string()->get();
+  const double time = e.get("time") ? e.get("time")->value<double>().value_or(0.0) : std::numeric_limits<double>::quiet_NaN();
+  const std::optional<double> fraction = scene.exact_signal_fraction(norm, time);
+  if (fraction && *fraction < kTrivialSignal)
+    warnings.push_back(fmt::format(
+        "{}: [[expect]] reads {} {} where the exact signal is {:.3g} % of its largest over the output times: a run "
+        "without the motion would score nearly the same; read it where the motion is large",
+        here, norm, std::isnan(time) ? std::string("at the end time") : fmt::format("at t = {:g}", time),
+        100.0 * *fraction));
+}
+
+}  // namespace
+
+void read_expectations(const toml::table& top, const std::string& path, const std::map<std::string, Study>& studies,
+                       Suite& suite) {
+  // Expectations name a study, keys of its scene and levels it has.
+  const toml::node* expects = top.get("expect");
+  if (!expects) return;
+  if (!expects->is_array_of_tables()) throw ConfigError(fmt::format("{}: 'expect' must be [[expect]] tables", where_in(path, *expects)));
+  for (const toml::node& node : *expects->as_array()) {
+    const toml::table& e = *node.as_table();
+    const std::string here = where_in(path, node);
+    expect_only(e, {"study", "where", "norm", "time", "refine", "levels", "order", "tolerance", "max_error_constant",
+                    "max_error", "must_complete", "interval_within_band"},
+                path, "[[expect]]");
+    const toml::node* study = e.get("study");
+    if (!study || !study->is_string()) throw ConfigError(fmt::format("{}: [[expect]] needs the study it checks", here));
+    const std::string name = study->as_string()->get();
+    if (!studies.count(name)) throw ConfigError(fmt::format("{}: [[expect]]: no study named '{}'", where_in(path, *study), name));
+    const std::vector<KeySpec>& specs = studies.at(name).keys;
+    auto is_key = [&](const std::string& k) {
+      return std::any_of(specs.begin(), specs.end(), [&](const KeySpec& s) { return s.name == k; });
+    };
+    if (const toml::node* w = e.get("where")) settings_of(table_at(*w, path, "where"), path, specs, name, "[[expect]] where");
+    const toml::node* norm = e.get("norm");
+    if (!norm || !norm->is_string()) throw ConfigError(fmt::format("{}: [[expect]] needs a norm (an /errors column, e.g. \"L1_theta0\")", here));
+    // An order with its band, or a bound on the error itself (exact-solution
+    // scenes whose error sits at round-off or settling level), or both.
+    const toml::node* max_error = e.get("max_error");
+    if (max_error && !(max_error->value<double>().value_or(-1.0) > 0.0))
+      throw ConfigError(fmt::format("{}: [[expect]]: 'max_error' must be a positive number", where_in(path, *max_error)));
+    if (!max_error || e.get("order") || e.get("tolerance")) {
+      for (const char* k : {"order", "tolerance"}) {
+        const toml::node* n = e.get(k);
+        if (!n || !(n->is_integer() || n->is_floating_point()))
+          throw ConfigError(fmt::format("{}: [[expect]] needs '{}' (a number){}", here, k,
+                                        max_error ? "" : ", or 'max_error' alone"));
+      }
+      if (const toml::node* t = e.get("tolerance"); !(t->value<double>().value_or(-1.0) > 0.0))
+        throw ConfigError(fmt::format("{}: [[expect]]: 'tolerance' must be positive", where_in(path, *t)));
+    }
+    if (e.get("max_error_constant") && !e.get("order"))
+      throw ConfigError(fmt::format("{}: [[expect]]: 'max_error_constant' needs an 'order'", here));
+    if (const toml::node* m = e.get("max_error_constant"); m && !(m->value<double>().value_or(-1.0) > 0.0))
+      throw ConfigError(fmt::format("{}: [[expect]]: 'max_error_constant' must be a positive number", where_in(path, *m)));
+    if (const toml::node* t = e.get("time"); t && !(t->value<double>().value_or(-1.0) >= 0.0))
+      throw ConfigError(fmt::format("{}: [[expect]]: 'time' must be a time >= 0", where_in(path, *t)));
+    for (const char* k : {"must_complete", "interval_within_band"})
+      if (const toml::node* m = e.get(k); m && !m->is_boolean())
+        throw ConfigError(fmt::format("{}: [[expect]]: '{}' must be true or false", where_in(path, *m), k));
+    if (e.get("interval_within_band") && !e.get("order"))
+      throw ConfigError(fmt::format("{}: [[expect]]: 'interval_within_band' needs an 'order'", here));
+    std::string refine = "cells";
+    if (const toml::node* r = e.get("refine")) {
+      if (!r->is_string() || !is_key(r->as_string()->get()))
+        throw ConfigError(fmt::format("{}: [[expect]]: 'refine' must name a key of study '{}'", where_in(path, *r), name));
+      refine = r->as_string()->get();
+    }
+    warn_of_a_trivial_read(e, here, *studies.at(name).first, suite.warnings);
+    if (const toml::node* l = e.get("levels")) {
+      const std::optional<Value> v = to_value(*l);
+      if (!v || !std::holds_alternative<std::vector<double>>(*v) || std::get<std::vector<double>>(*v).size() < 2)
+        throw ConfigError(fmt::format("{}: [[expect]]: 'levels' must list two or more values of '{}'", where_in(path, *l), refine));
+      for (double level : std::get<std::vector<double>>(*v)) {
+        const bool present = std::any_of(suite.cases.begin(), suite.cases.end(), [&](const SuiteCase& c) {
+          const auto key = c.keys.find(refine);
+          return c.study == name && key != c.keys.end() && key->second.is_number() &&
+                 std::abs(key->second.get<double>() - level) < 1e-12 * std::max(1.0, std::abs(level));
+        });
+        if (!present)
+          throw ConfigError(fmt::format("{}: [[expect]]: study '{}' has no case with {} = {}", where_in(path, *l), name, refine, level));
+      }
+    }
+    // Checked: as the manifest records it for the gate and the report,
+    // which read it there and check nothing of it again.
+    if (const toml::node* bad = non_finite(e))
+      throw ConfigError(fmt::format("{}: [[expect]] holds a value that is not a finite number (nan or inf)",
+                                    where_in(path, *bad)));
+    std::ostringstream as_json;
+    as_json << toml::json_formatter{e};
+    suite.expectations.push_back(Json::parse(as_json.str()));
+  }
+}
+
+}  // namespace mpmvv::app::suite_file
