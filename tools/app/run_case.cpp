@@ -24,6 +24,7 @@
 #include "mpmvv_commit.hpp"
 #include "fault.hpp"
 #include "scene.hpp"
+#include "scene/results_file.hpp"
 #include "solver/parallel.hpp"
 #include "solver/time_loop.hpp"
 #include "suite/suite.hpp"
@@ -75,96 +76,6 @@ std::string compact(const Config& c) {
   std::string s;
   for (const KeySpec& k : c.specs()) s += fmt::format(" {}={}", k.name, format_value(c.value(k.name)));
   return s;
-}
-
-void set_key_attribute(h5::Group& root, const std::string& name, const Value& v) {
-  std::visit(
-      [&](const auto& x) {
-        using T = std::decay_t<decltype(x)>;
-        if constexpr (std::is_same_v<T, std::int64_t>) root.set_attribute(name, x);
-        else if constexpr (std::is_same_v<T, double>) root.set_attribute(name, x);
-        else if constexpr (std::is_same_v<T, std::string>) root.set_attribute(name, x);
-        else root.set_attribute(name, x);
-      },
-      v);
-}
-
-// A run that reached its end time with its solution lost (RunHealth) is not
-// "completed": its status is "lost", and its failure names the rule.
-const char* run_status(const RunOutcome& o, const RunHealth& health) {
-  if (o.completed) return health.lost ? "lost" : "completed";
-  return o.failure_reason == kInterrupted ? kInterrupted : "failed";
-}
-
-// Everything a results file holds, under its root group.
-void write_run(h5::Group root, const RunRequest& request, const Config& config, const SceneCase& scene,
-               const RunOutcome& o, const RunHealth& health, Fault fault) {
-  // Every scene key as an attribute of its own, then what the run measured.
-  for (const KeySpec& k : config.specs()) set_key_attribute(root, k.name, config.value(k.name));
-  root.set_attribute("scene", config.scene());
-  root.set_attribute("configuration", config.to_toml());
-  root.set_attribute("scene_file", request.scene_file);
-  {
-    std::ifstream in(request.scene_file);
-    std::ostringstream text;
-    text << in.rdbuf();
-    root.set_attribute("scene_file_text", text.str());
-  }
-  std::string overrides;
-  for (const std::string& s : request.overrides) overrides += (overrides.empty() ? "" : "\n") + s;
-  root.set_attribute("overrides", overrides);
-  root.set_attribute("command_line", request.command_line);
-  root.set_attribute("version", version_string());
-  if (fault != Fault::none) root.set_attribute("fault_injected", to_string(fault));
-  root.set_attribute("threads", std::int64_t(max_threads()));
-  root.set_attribute("status", run_status(o, health));
-  const bool lost_at_end = o.completed && health.lost;
-  root.set_attribute("failure_reason", lost_at_end ? std::string("solution lost") : o.failure_reason);
-  root.set_attribute("failure_detail", lost_at_end ? health.reason : o.failure_detail);
-  root.set_attribute("failure_time", lost_at_end ? health.time : o.failure_time);
-  root.set_attribute("health", health.lost ? "solution lost" : "healthy");
-  root.set_attribute("health_reason", health.reason);
-  root.set_attribute("health_time", health.time);
-  if (health.reference_position)
-    root.set_attribute("health_reference_position",
-                       std::vector<double>{health.reference_position->x(), health.reference_position->y()});
-  root.set_attribute("failure_step", std::int64_t(o.failure_step));
-  root.set_attribute("failure_particle", std::int64_t(o.failure_particle));
-  root.set_attribute("time_reached", o.time_reached);
-  root.set_attribute("steps", std::int64_t(o.steps));
-  root.set_attribute("particle_count", std::int64_t(scene.particle_count()));
-  root.set_attribute("particle_steps", std::int64_t(o.particle_steps));
-  root.set_attribute("wall_time_s", o.wall_seconds);
-  root.set_attribute("solver_time_s", o.wall_seconds - o.forcing_seconds);
-  root.set_attribute("forcing_time_s", o.forcing_seconds);
-  root.set_attribute("particle_steps_per_second", o.wall_seconds > 0 ? double(o.particle_steps) / o.wall_seconds : 0.0);
-  root.set_attribute("h", scene.cell_size());
-  root.set_attribute("geometry", to_string(scene.geometry()));
-  root.set_attribute("body_force", scene.body_force_kind());
-  root.set_attribute("seeding", scene.seeding());
-  root.set_attribute("particle_volume", scene.particle_volume());
-  root.set_attribute("body_volume", scene.body_volume());
-  root.set_attribute("volume_error", scene.particle_volume() / scene.body_volume() - 1.0);
-  root.set_attribute("dt", o.dt_first);
-  root.set_attribute("dt_min", o.dt_min);
-  root.set_attribute("dt_max", o.dt_max);
-  root.set_attribute("frequency_measurements", static_cast<double>(o.frequency_measurements));
-  // A run continued from restart files: the times it went on from (none for
-  // a run in one piece); its wall time is that of the parts that made it.
-  root.set_attribute("resumed_at", o.resumed_at);
-  scene.write_results(root);
-  write_errors(root, scene.errors(), scene.error_description());
-  if (const auto m = scene.measurements(); !m.empty()) {
-    h5::Group g = root.create_group("measurements");
-    for (const auto& [name, value] : m) g.set_attribute(name, value);
-  }
-}
-
-void write_results_file(const std::string& path, const RunRequest& request, const Config& config,
-                        const SceneCase& scene, const RunOutcome& o, const RunHealth& health, Fault fault) {
-  h5::File file = h5::File::create(path);
-  write_run(file.root(), request, config, scene, o, health, fault);  // the root group closes on return
-  file.save();
 }
 
 // The first line where two texts differ, for a message.
@@ -359,7 +270,8 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
   const RunHealth health = scene->health();
   const std::string partial = output + ".partial";
   try {
-    write_results_file(partial, request, config, *scene, o, health, fault);
+    write_results_file(partial, {request.scene_file, request.overrides, request.command_line, version_string()}, config,
+                       *scene, o, health, fault);
     fs::rename(partial, output);
   } catch (const std::exception& e) {
     std::error_code ec;

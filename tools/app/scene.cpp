@@ -215,48 +215,4 @@ void print_measurements(std::ostream& out, const std::vector<std::pair<std::stri
   for (const auto& [name, value] : measurements) fmt::print(out, "{:<28} {:.9g}\n", name, value);
 }
 
-void write_errors(h5::Group& root, const ErrorTable& errors, const std::string& description) {
-  h5::Group e = root.create_group("errors");
-  e.set_attribute("description", description);
-  e.write("time", errors.time, {errors.time.size()});
-  for (const auto& [name, values] : errors.columns) e.write(name, values, {values.size()});
-}
-
-// Each field is written a block of rows at a time from the particle arrays
-// (h5::Group::write_rows): staging the whole set would add 12 doubles a
-// particle (20 with corner domains) to the run's memory at its last moment.
-void write_particles(h5::Group& root, const Particles& P) {
-  h5::Group g = root.create_group("particles");
-  const std::size_t n = P.size();
-  // Rows of `per_row` 2-vectors from a field that holds them one row after another.
-  auto vectors = [](const auto& field, std::size_t per_row = 1) {
-    return [&field, per_row](std::size_t first, std::size_t count, double* out) {
-      for (std::size_t k = per_row * first; k < per_row * (first + count); ++k, out += 2) {
-        out[0] = field[k].x();
-        out[1] = field[k].y();
-      }
-    };
-  };
-  auto scalars = [](const auto& value) {
-    return [&value](std::size_t first, std::size_t count, double* out) {
-      for (std::size_t p = first; p < first + count; ++p) *out++ = value(p);
-    };
-  };
-  g.write_rows("reference_position", {n, 2}, vectors(P.reference_position));
-  g.write_rows("position", {n, 2}, vectors(P.position));
-  g.write_rows("velocity", {n, 2}, vectors(P.velocity));
-  g.write_rows("volume", {n}, scalars([&](std::size_t p) { return P.volume[p]; }));
-  g.write_rows("J", {n}, scalars([&](std::size_t p) { return determinant(P.deformation_gradient[p]); }));
-  g.write_rows("deformation_gradient", {n, 2, 2}, [&](std::size_t first, std::size_t count, double* out) {
-    for (std::size_t p = first; p < first + count; ++p)
-      for (int k = 0; k < 4; ++k) *out++ = P.deformation_gradient[p](k / 2, k % 2);
-  });
-  // Corner domains (cpdi_domain = "corners") are whole quadrilaterals, not
-  // F_p times the reference half-vectors: store their corners so a reader can
-  // draw the domains the transfers used, counter-clockwise from (-1, -1).
-  if (P.domain_corner.size() == 4 * n && n > 0) {
-    g.write_rows("domain_corners", {n, 4, 2}, vectors(P.domain_corner, 4));
-  }
-}
-
 }  // namespace mpmvv::app

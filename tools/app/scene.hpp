@@ -116,10 +116,4 @@ void print_error_table(std::ostream& out, const ErrorTable& errors);
 // Prints the measurements, one per line.
 void print_measurements(std::ostream& out, const std::vector<std::pair<std::string, double>>& measurements);
 
-// Writes /errors: time and one dataset per column.
-void write_errors(h5::Group& root, const ErrorTable& errors, const std::string& description);
-
-// Writes the particle arrays every results file carries.
-void write_particles(h5::Group& root, const Particles& particles);
-
 }  // namespace mpmvv::app

@@ -1,0 +1,50 @@
+// The results file: every run's configuration, outcome and health as
+// attributes of its root, then /particles, /errors, /probes (lines, points,
+// the circle, histories, the scene's own, the monitors), /settling and
+// /measurements. The whole layout is written here; reports/results-format.md
+// documents it for the readers (reports/results.py).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "solver/io/hdf5.hpp"
+#include "solver/model.hpp"
+#include "tools/app/config.hpp"
+#include "tools/app/fault.hpp"
+#include "tools/app/health.hpp"
+#include "tools/app/scene.hpp"
+#include "tools/app/settling.hpp"
+
+namespace mpmvv::app {
+
+class ProbeRecorder;
+class MonitorLog;
+
+// How the run was asked for, as the root's attributes record it.
+struct RunIdentity {
+  std::string scene_file;
+  std::vector<std::string> overrides;  // "key=value"
+  std::string command_line;
+  std::string version;
+};
+
+// A run that reached its end time with its solution lost (RunHealth) is not
+// "completed": its status is "lost", and its failure names the rule.
+const char* run_status(const RunOutcome& o, const RunHealth& health);
+
+// Writes the whole file at `path` (HDF5 through solver/io/hdf5.hpp).
+void write_results_file(const std::string& path, const RunIdentity& identity, const Config& config,
+                        const SceneCase& scene, const RunOutcome& o, const RunHealth& health, Fault fault);
+
+// The groups a scene writes (SceneCase::write_results).
+void write_particles(h5::Group& root, const Particles& particles);
+void write_errors(h5::Group& root, const ErrorTable& errors, const std::string& description);
+void write_probes(h5::Group& probes, const ProbeRecorder& recorder);
+void write_monitors(h5::Group& probes, const MonitorLog& log, bool stable_step);
+// A static scene's distance from its static state at the end time `end`
+// (settling.hpp), `at_end` measured there.
+void write_settling(h5::Group& root, const SettlingWatch& watch, const Settling& at_end, double end,
+                    const ErrorTable& errors);
+
+}  // namespace mpmvv::app
