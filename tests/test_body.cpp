@@ -1,4 +1,4 @@
-// Exact body geometry (tools/app/body.hpp): areas and first moments of whole
+// Exact body geometry (tools/app/scene/body.hpp): areas and first moments of whole
 // bodies and of their parts in boxes, from CGAL's exact Boolean intersection
 // and Green's theorem; the inside test and the cut-box test the seeding uses.
 #include <gtest/gtest.h>
@@ -9,8 +9,8 @@
 #include <numbers>
 #include <random>
 
-#include "tools/app/body.hpp"
-#include "tools/app/scene.hpp"
+#include "tools/app/scene/body.hpp"
+#include "tools/app/scene/scene.hpp"
 
 namespace {
 

@@ -22,7 +22,7 @@
 #include "solver/explicit_stepper.hpp"
 #include "solver/rest_points.hpp"
 #include "solver/shape/bspline.hpp"
-#include "tools/app/scene.hpp"
+#include "tools/app/scene/scene.hpp"
 
 namespace {
 

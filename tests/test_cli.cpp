@@ -13,7 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "tools/app/mms_scene.hpp"
+#include "tools/app/scene/setup.hpp"
 
 namespace {
 
@@ -210,9 +210,9 @@ TEST_F(Cli, MmsEvalUnknownSolutionExitsTwo) {
 // Mooney-Rivlin ring at A = 2, whose residual, 2.2e-8, the former fixed
 // tolerance 1e-8 failed.
 TEST_F(Cli, MmsCheckPassesForEverySolution) {
-  for (const mpmvv::app::MmsProblem& problem : mpmvv::app::mms_problems()) {
-    const Outcome o = mpmvv("mms check " + problem.name + " --points 200");
-    EXPECT_EQ(o.status, 0) << problem.name << "\n" << o.out << o.err;
+  for (const mpmvv::app::SceneType& scene : mpmvv::app::scene_types()) {
+    const Outcome o = mpmvv("mms check " + scene.name + " --points 200");
+    EXPECT_EQ(o.status, 0) << scene.name << "\n" << o.out << o.err;
     EXPECT_NE(o.out.find("PASS"), std::string::npos) << o.out;
     EXPECT_EQ(o.out.find("FAIL"), std::string::npos) << o.out;
   }

@@ -15,7 +15,7 @@
 #include <toml++/toml.h>
 
 #include "tools/app/config.hpp"
-#include "tools/app/scene.hpp"
+#include "tools/app/scene/scene.hpp"
 
 namespace {
 

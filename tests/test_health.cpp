@@ -1,4 +1,4 @@
-// The health verdict (tools/app/health.hpp): each rule marks a run lost at the
+// The health verdict (tools/app/scene/health.hpp): each rule marks a run lost at the
 // first output time it fails, a run within every rule stays healthy, and
 // `mpmvv run` writes a lost run as status "lost" with exit status 1.
 #include <gtest/gtest.h>
@@ -12,8 +12,8 @@
 #include <string>
 
 #include "solver/io/hdf5.hpp"
-#include "tools/app/health.hpp"
-#include "tools/app/scene.hpp"
+#include "tools/app/scene/health.hpp"
+#include "tools/app/scene/scene.hpp"
 
 namespace {
 

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "solver/implicit/newton_krylov.hpp"
-#include "tools/app/scene.hpp"
+#include "tools/app/scene/scene.hpp"
 
 namespace {
 

@@ -1,6 +1,6 @@
 // The manufactured-solution generator (mms/jet.hpp, mms/manufactured.hpp,
 // mms/exact_solution.hpp) and the four problems built on it
-// (tools/app/problems/): forward-mode derivatives are exact, every derived
+// (tools/app/scenes/): forward-mode derivatives are exact, every derived
 // body force passes the independent finite-difference residual check (what
 // `mpmvv mms check` computes), the check fails when force, motion and material
 // disagree, the ring's derived force equals its closed form (eqs. 2.14-2.15),
@@ -30,7 +30,7 @@
 #include "mms/manufactured.hpp"
 #include "mms/ring.hpp"
 #include "mms/rz_cylinder.hpp"
-#include "tools/app/mms_scene.hpp"
+#include "tools/app/scene/setup.hpp"
 
 namespace {
 
@@ -42,7 +42,7 @@ using mpmvv::NeoHookean;
 using mpmvv::Particles;
 using mpmvv::Vec2;
 using mpmvv::app::Config;
-using mpmvv::app::ProblemSetup;
+using mpmvv::app::SceneSetup;
 using mpmvv::mms::ExactFields;
 using mpmvv::mms::ExactSolution;
 using mpmvv::mms::Jet;
@@ -298,15 +298,15 @@ const ProblemCase kProblemCases[] = {
 };
 
 Config config_for(const ProblemCase& c) {
-  const mpmvv::app::MmsProblem* problem = mpmvv::app::find_mms_problem(c.problem);
+  const mpmvv::app::SceneType* problem = mpmvv::app::find_scene_type(c.problem);
   if (!problem) throw std::runtime_error(std::string("no problem ") + c.problem);
   Config config(problem->name, problem->keys());
   for (const std::string& o : c.overrides) config.set_from_text(o);
   return config;
 }
 
-ProblemSetup setup_for(const ProblemCase& c) {
-  return mpmvv::app::find_mms_problem(c.problem)->setup(config_for(c));
+SceneSetup setup_for(const ProblemCase& c) {
+  return mpmvv::app::find_scene_type(c.problem)->setup(config_for(c));
 }
 
 struct Sample {
@@ -318,7 +318,7 @@ struct Sample {
 // along both axes (the finite differences of check() reach 3e-3 of the
 // motion's length scale) and, in r-z, at R > 0.02 R_o, with times in
 // [0, end_time]; rejection sampling in the walled box from a fixed seed.
-std::vector<Sample> body_samples(const ProblemSetup& s, const Config& c, std::size_t count, unsigned seed) {
+std::vector<Sample> body_samples(const SceneSetup& s, const Config& c, std::size_t count, unsigned seed) {
   std::mt19937 rng(seed);
   const Vec2 lo = s.grid.wall_lower(), hi = s.grid.wall_upper();
   std::uniform_real_distribution<double> ux(lo.x(), hi.x()), uy(lo.y(), hi.y()), ut(0.0, c.real("end_time"));
@@ -363,7 +363,7 @@ INSTANTIATE_TEST_SUITE_P(AllProblems, ProblemTest, ::testing::ValuesIn(kProblemC
 // worst; a force off by 1e-4 gives 5e-5 (CatchesForceMaterialAndMotionMismatches).
 TEST_P(ProblemTest, DerivedForcePassesTheResidualCheck) {
   const Config config = config_for(GetParam());
-  const ProblemSetup s = setup_for(GetParam());
+  const SceneSetup s = setup_for(GetParam());
   const std::vector<Sample> points = body_samples(s, config, 300, 7);
   const double residual = largest_relative_residual(*s.solution, points);
   RecordProperty("largest_relative_residual", scientific(residual));
@@ -377,7 +377,7 @@ TEST_P(ProblemTest, DerivedForcePassesTheResidualCheck) {
 // rather than wrong.
 TEST_P(ProblemTest, StateIsFieldsWithoutTheBodyForce) {
   const Config config = config_for(GetParam());
-  const ProblemSetup s = setup_for(GetParam());
+  const SceneSetup s = setup_for(GetParam());
   auto same = [](const auto& a, const auto& b) { return a.cwiseEqual(b).all(); };
   for (const Sample& p : body_samples(s, config, 300, 13)) {
     const ExactFields f = s.solution->fields(p.X, p.t), g = s.solution->state(p.X, p.t);
@@ -407,7 +407,7 @@ TEST_P(ProblemTest, StateIsFieldsWithoutTheBodyForce) {
 // (baseline and AVX2 four points at a time, AVX-512 eight).
 TEST_P(ProblemTest, FactoredForceIsThePointwiseForce) {
   const Config config = config_for(GetParam());
-  const ProblemSetup s = setup_for(GetParam());
+  const SceneSetup s = setup_for(GetParam());
   ASSERT_NE(s.solution->factored_force_field(), nullptr) << GetParam().label;
   std::vector<Vec2> X;
   for (const Sample& p : body_samples(s, config, 301, 19)) X.push_back(p.X);
@@ -451,7 +451,7 @@ TEST_P(ProblemTest, FactoredForceIsThePointwiseForce) {
 // (groups of four lanes filled part way both times).
 TEST_P(ProblemTest, FactoredForcePlacedInPiecesIsTheFieldPreparedWhole) {
   const Config config = config_for(GetParam());
-  const ProblemSetup s = setup_for(GetParam());
+  const SceneSetup s = setup_for(GetParam());
   std::vector<Vec2> X;
   for (const Sample& p : body_samples(s, config, 301, 29)) X.push_back(p.X);
   const std::shared_ptr<mpmvv::mms::ForceField> whole = mpmvv::mms::derived_force_field(s.solution);
@@ -476,7 +476,7 @@ TEST_P(ProblemTest, FactoredForcePlacedInPiecesIsTheFieldPreparedWhole) {
 // relative to the body's size allows a rounding step).
 TEST_P(ProblemTest, InitialFieldsComeFromTheMotion) {
   const Config config = config_for(GetParam());
-  const ProblemSetup s = setup_for(GetParam());
+  const SceneSetup s = setup_for(GetParam());
   const double size = (s.grid.wall_upper() - s.grid.wall_lower()).norm();
   double worst = 0.0;
   for (const Sample& p : body_samples(s, config, 50, 11)) {
@@ -628,7 +628,7 @@ TEST(ResidualCheck, ToleranceFromTheDifferencesOwnError) {
   cases.push_back({"ring_mooney_rivlin_A2", "ring", {"material=mooney-rivlin", "c2=50", "body_force=derived", "amplitude=2"}});
   for (const ProblemCase& c : cases) {
     const Config config = config_for(c);
-    const ProblemSetup s = setup_for(c);
+    const SceneSetup s = setup_for(c);
     const std::vector<Sample> points = body_samples(s, config, 500, 1);
     auto verdict = [&](const ExactSolution& solution) {
       std::vector<ResidualCheck> fine, coarse;
@@ -826,7 +826,7 @@ TEST(ExpandingRingClosedForm, ClosedFormFieldEqualsDerivedField) {
 TEST(InitialConditions, AxisAlignedStartsDisplacedWithConsistentF) {
   const ProblemCase c{"axis_aligned_2d", "axis-aligned", {}};
   const Config config = config_for(c);
-  const ProblemSetup s = setup_for(c);
+  const SceneSetup s = setup_for(c);
   const double A = config.real("amplitude");
   double largest_u_y = 0.0, worst_F = 0.0;
   for (const Sample& p : body_samples(s, config, 100, 13)) {
@@ -861,7 +861,7 @@ TEST(InitialConditions, RingStartsWithTheTimeFunctionsVelocity) {
     const std::string time_function = c.time_function == RingTimeFunction::sine ? "sine" : "cosine";
     const ProblemCase pc{"ring", "ring",
                          {"time_function=" + time_function, "amplitude=" + std::to_string(c.amplitude)}};
-    const ProblemSetup s = setup_for(pc);
+    const SceneSetup s = setup_for(pc);
     double worst = 0.0;
     for (const Sample& q : ring_samples(50, 29)) {
       const ExactFields f = s.solution->fields(q.X, 0.0);
@@ -884,7 +884,7 @@ TEST(InitialConditions, RingStartsWithTheTimeFunctionsVelocity) {
 TEST(InitialConditions, ExpandingRingStartsWithItsRadialVelocity) {
   const ProblemCase c{"expanding_ring", "expanding-ring", {}};
   const Config config = config_for(c);
-  const ProblemSetup s = setup_for(c);
+  const SceneSetup s = setup_for(c);
   const mpmvv::mms::ExpandingRingMotion m;  // the same defaults as the problem's keys
   ASSERT_EQ(config.real("amplitude"), m.amplitude);
   ASSERT_EQ(config.real("inner_radius"), m.inner_radius);
@@ -915,7 +915,7 @@ TEST(InitialConditions, RzCylinderStartsAtRestUnstressed) {
   for (const char* inner : {"inner_radius=0.25", "inner_radius=0"}) {
     const ProblemCase c{"rz", "rz-cylinder", {inner}};
     const Config config = config_for(c);
-    const ProblemSetup s = setup_for(c);
+    const SceneSetup s = setup_for(c);
     for (const Sample& q : body_samples(s, config, 50, 37)) {
       const ExactFields f = s.solution->fields(q.X, 0.0);
       EXPECT_EQ(f.displacement, Vec2::Zero());
@@ -938,7 +938,7 @@ TEST(RzFields, HoopStretchIsCurrentOverReferenceRadius) {
   for (const char* inner : {"inner_radius=0.25", "inner_radius=0"}) {
     const ProblemCase c{"rz", "rz-cylinder", {inner}};
     const Config config = config_for(c);
-    const ProblemSetup s = setup_for(c);
+    const SceneSetup s = setup_for(c);
     ASSERT_EQ(s.solution->geometry(), Geometry::axisymmetric);
     double largest = 0.0;
     for (const Sample& q : body_samples(s, config, 200, 41)) {
@@ -957,7 +957,7 @@ TEST(RzFields, HoopStretchIsCurrentOverReferenceRadius) {
 // requires (F_theta = 1 + g q(0) cos(pi Z / H) = F_rR at R = 0): at R = 1e-6 they
 // differ by less than 1e-5 (measured 3.8e-7: both move by O(R) off the axis).
 TEST(RzFields, SolidCylinderHoopStretchMeetsRadialStretchOnTheAxis) {
-  const ProblemSetup s = setup_for({"rz_solid", "rz-cylinder", {"inner_radius=0"}});
+  const SceneSetup s = setup_for({"rz_solid", "rz-cylinder", {"inner_radius=0"}});
   double worst = 0.0;
   for (double Z : {0.1, 0.4, 0.8})
     for (double t : {0.25, 0.5}) {
@@ -978,7 +978,7 @@ TEST(RzFields, SolidCylinderHoopStretchMeetsRadialStretchOnTheAxis) {
 TEST(RzFields, ExpandingRingRimsAreTractionFree) {
   const ProblemCase c{"expanding_ring", "expanding-ring", {}};
   const Config config = config_for(c);
-  const ProblemSetup s = setup_for(c);
+  const SceneSetup s = setup_for(c);
   const double mu = config.real("mu");
   const double ri = config.real("inner_radius"), ro = config.real("outer_radius");
   // A quarter period of sin(C pi t / (2 r_b)) is r_b / C = 5e-3 s.
@@ -1011,7 +1011,7 @@ TEST(RzFields, CylinderRimsAreTractionFree) {
   for (const char* inner : {"inner_radius=0.25", "inner_radius=0"}) {
     const ProblemCase c{"rz", "rz-cylinder", {inner}};
     const Config config = config_for(c);
-    const ProblemSetup s = setup_for(c);
+    const SceneSetup s = setup_for(c);
     const double mu = config.real("mu"), ri = config.real("inner_radius"), ro = config.real("outer_radius");
     std::vector<double> rims = {ro};
     if (ri > 0.0) rims.push_back(ri);

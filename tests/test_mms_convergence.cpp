@@ -44,7 +44,7 @@
 #include <string>
 #include <vector>
 
-#include "tools/app/scene.hpp"
+#include "tools/app/scene/scene.hpp"
 
 namespace {
 

@@ -14,7 +14,7 @@
 #include "solver/shape/cpdi.hpp"
 #include "solver/shape/total_lagrangian.hpp"
 #include "solver/stages.hpp"
-#include "tools/app/scene.hpp"
+#include "tools/app/scene/scene.hpp"
 
 namespace {
 

@@ -14,7 +14,7 @@
 #include <string>
 
 #include "solver/io/hdf5.hpp"
-#include "tools/app/scene.hpp"
+#include "tools/app/scene/scene.hpp"
 
 namespace {
 

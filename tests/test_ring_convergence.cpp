@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "tools/app/scene.hpp"
+#include "tools/app/scene/scene.hpp"
 
 namespace {
 

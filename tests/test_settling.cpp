@@ -1,5 +1,5 @@
 // How far a static scene's end still is from its static state
-// (tools/app/settling.hpp), the measurements the report and the gate compare
+// (tools/app/scene/settling.hpp), the measurements the report and the gate compare
 // errors with: the relaxation's estimate is exact for a motion that decays at
 // the slowest rate of the damped lowest mode; a run stopped sooner has further
 // to go; implicit load steps report the Newton correction left, which a looser
@@ -10,7 +10,7 @@
 #include <string>
 
 #include "run_scene.hpp"
-#include "tools/app/settling.hpp"
+#include "tools/app/scene/settling.hpp"
 
 namespace {
 

@@ -9,27 +9,27 @@
 #include <fmt/ostream.h>
 
 #include "json.hpp"
-#include "mms_scene.hpp"
+#include "scene/setup.hpp"
 
 namespace mpmvv::app {
 
 namespace {
 
-// The problem's configuration with its defaults and the overrides; throws ConfigError.
-const MmsProblem& problem_named(const std::string& name) {
-  const MmsProblem* p = find_mms_problem(name);
+// The scene's configuration with its defaults and the overrides; throws ConfigError.
+const SceneType& scene_named(const std::string& name) {
+  const SceneType* p = find_scene_type(name);
   if (!p) {
     std::string names;
-    for (const MmsProblem& q : mms_problems()) names += (names.empty() ? "" : ", ") + q.name;
+    for (const SceneType& q : scene_types()) names += (names.empty() ? "" : ", ") + q.name;
     throw ConfigError(fmt::format("unknown manufactured solution '{}' (known: {})", name, names));
   }
   return *p;
 }
 
-ProblemSetup setup_for(const MmsProblem& problem, const std::vector<std::string>& overrides) {
-  Config config(problem.name, problem.keys());
+SceneSetup setup_for(const SceneType& scene, const std::vector<std::string>& overrides) {
+  Config config(scene.name, scene.keys());
   for (const std::string& o : overrides) config.set_from_text(o);
-  return problem.setup(config);
+  return scene.setup(config);
 }
 
 Json json_of(const Vec2& v) { return {v.x(), v.y()}; }
@@ -42,7 +42,7 @@ Json json_of(const Mat2& m) { return {{m(0, 0), m(0, 1)}, {m(1, 0), m(1, 1)}}; }
 // none (eval and check take those too; `mpmvv scenes` lists every scene).
 std::string mms_list() {
   std::string s, exact_only;
-  for (const MmsProblem& p : mms_problems()) {
+  for (const SceneType& p : scene_types()) {
     if (setup_for(p, {}).force_free) {
       exact_only += (exact_only.empty() ? "" : ", ") + p.name;
       continue;
@@ -64,11 +64,11 @@ std::string mms_list() {
 }
 
 int mms_eval(const MmsEvalRequest& r, std::ostream& out, std::ostream& err) {
-  ProblemSetup setup;
+  SceneSetup setup;
   try {
-    const MmsProblem& problem = problem_named(r.name);
+    const SceneType& scene = scene_named(r.name);
     if (r.at.size() != 2) throw ConfigError("--at takes two coordinates, X,Y (R,Z in r-z)");
-    setup = setup_for(problem, r.overrides);
+    setup = setup_for(scene, r.overrides);
     const Vec2 X(r.at[0], r.at[1]);
     if (!setup.contains(X))
       throw ConfigError(fmt::format("--at {},{}: the point lies outside the body of '{}'", X.x(), X.y(), r.name));
@@ -120,13 +120,13 @@ int mms_eval(const MmsEvalRequest& r, std::ostream& out, std::ostream& err) {
 }
 
 int mms_check(const MmsCheckRequest& r, std::ostream& out, std::ostream& err) {
-  ProblemSetup setup;
+  SceneSetup setup;
   Config config("", {});
   try {
-    const MmsProblem& problem = problem_named(r.name);
-    config = Config(problem.name, problem.keys());
+    const SceneType& scene = scene_named(r.name);
+    config = Config(scene.name, scene.keys());
     for (const std::string& o : r.overrides) config.set_from_text(o);
-    setup = problem.setup(config);
+    setup = scene.setup(config);
   } catch (const ConfigError& e) {
     fmt::print(err, "mpmvv mms check: {}\n", e.what());
     return 2;

@@ -23,7 +23,7 @@
 #include "config.hpp"
 #include "mpmvv_commit.hpp"
 #include "fault.hpp"
-#include "scene.hpp"
+#include "scene/scene.hpp"
 #include "scene/results_file.hpp"
 #include "solver/parallel.hpp"
 #include "solver/time_loop.hpp"

@@ -21,14 +21,14 @@
 #include "mms/exact_solution.hpp"
 #include "mms/ring.hpp"
 #include "solver/parallel.hpp"
-#include "tools/app/mms_scene.hpp"
+#include "tools/app/scene/setup.hpp"
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// Reference points of the problem's body, uniformly at random.
-std::vector<mpmvv::Vec2> body_points(const mpmvv::app::ProblemSetup& s, std::size_t count) {
+// Reference points of the scene's body, uniformly at random.
+std::vector<mpmvv::Vec2> body_points(const mpmvv::app::SceneSetup& s, std::size_t count) {
   std::mt19937 rng(3);
   const mpmvv::Vec2 lo = s.grid.wall_lower(), hi = s.grid.wall_upper();
   std::uniform_real_distribution<double> ux(lo.x(), hi.x()), uy(lo.y(), hi.y());
@@ -42,7 +42,7 @@ std::vector<mpmvv::Vec2> body_points(const mpmvv::app::ProblemSetup& s, std::siz
 
 // The best of three evaluations at all points, by the field (prepared first)
 // or, without one, point by point.
-double nanoseconds_per_evaluation(const mpmvv::app::ProblemSetup& s, const std::vector<mpmvv::Vec2>& X,
+double nanoseconds_per_evaluation(const mpmvv::app::SceneSetup& s, const std::vector<mpmvv::Vec2>& X,
                                   const std::shared_ptr<mpmvv::mms::ForceField>& field) {
   std::vector<mpmvv::Vec2> b(X.size());
   if (field) field->prepare(X);
@@ -75,7 +75,7 @@ int main(int argc, char** argv) {
   struct Variant {
     std::string label, problem;
     std::vector<std::string> overrides;
-    bool closed_form = false;  // the problem's closed form (ProblemSetup::fast_body_force)
+    bool closed_form = false;  // the scene's closed form (SceneSetup::fast_body_force)
   };
   const std::vector<Variant> variants = {
       {"ring (derived)", "ring", {"body_force=derived"}},
@@ -91,10 +91,10 @@ int main(int argc, char** argv) {
       {"rz-cylinder (closed form)", "rz-cylinder", {}, true},
   };
   for (const Variant& v : variants) {
-    const mpmvv::app::MmsProblem& problem = *mpmvv::app::find_mms_problem(v.problem);
-    mpmvv::app::Config config(problem.name, problem.keys());
+    const mpmvv::app::SceneType& scene = *mpmvv::app::find_scene_type(v.problem);
+    mpmvv::app::Config config(scene.name, scene.keys());
     for (const std::string& o : v.overrides) config.set_from_text(o);
-    const mpmvv::app::ProblemSetup s = problem.setup(config);
+    const mpmvv::app::SceneSetup s = scene.setup(config);
     const std::vector<mpmvv::Vec2> X = body_points(s, points);
     if (v.closed_form) {
       fmt::print("{:<34} {:>14.1f}\n", v.label, nanoseconds_per_evaluation(s, X, s.fast_body_force));

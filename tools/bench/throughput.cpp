@@ -18,7 +18,7 @@
 
 #include "solver/parallel.hpp"
 #include "solver/shape/cpdi_lanes.hpp"
-#include "tools/app/scene.hpp"
+#include "tools/app/scene/scene.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"Particle-steps per second of the explicit MPM step on the ring scene."};

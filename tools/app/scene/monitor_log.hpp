@@ -12,7 +12,7 @@
 #include "mms/exact_solution.hpp"
 #include "solver/monitors.hpp"
 #include "solver/stepper.hpp"
-#include "tools/app/health.hpp"
+#include "tools/app/scene/health.hpp"
 
 namespace mpmvv::app {
 

@@ -80,7 +80,7 @@ FieldErrors field_errors(const Particles& P, const mms::ExactSolution& solution,
   return {pressure, deformation, velocity, spin};
 }
 
-std::optional<double> exact_signal_fraction(const ProblemSetup& setup, const TimeLoopOptions& loop,
+std::optional<double> exact_signal_fraction(const SceneSetup& setup, const TimeLoopOptions& loop,
                                             const std::string& norm, double time) {
   if (!setup.solution) return std::nullopt;
   if (std::isnan(time)) time = loop.end_time;

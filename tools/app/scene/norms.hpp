@@ -12,7 +12,7 @@
 #include "mms/exact_solution.hpp"
 #include "solver/model.hpp"
 #include "solver/time_loop.hpp"
-#include "tools/app/mms_scene.hpp"
+#include "tools/app/scene/setup.hpp"
 
 namespace mpmvv::app {
 
@@ -67,7 +67,7 @@ struct TimeIntegral {
 
 // SceneCase::exact_signal_fraction for a scene set up as `setup` with time
 // loop `loop` (scene.hpp).
-std::optional<double> exact_signal_fraction(const ProblemSetup& setup, const TimeLoopOptions& loop,
+std::optional<double> exact_signal_fraction(const SceneSetup& setup, const TimeLoopOptions& loop,
                                             const std::string& norm, double time);
 
 }  // namespace mpmvv::app

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "solver/stepper.hpp"
-#include "tools/app/mms_scene.hpp"
+#include "tools/app/scene/setup.hpp"
 
 namespace mpmvv::app {
 
@@ -21,7 +21,7 @@ double probe_value(ProbeQuantity q, Geometry geometry, const Vec2& x, const Vec2
 
 class ProbeRecorder {
  public:
-  explicit ProbeRecorder(const ProblemSetup& setup) : setup_(setup) {}
+  explicit ProbeRecorder(const SceneSetup& setup) : setup_(setup) {}
 
   // Appends a tracer for each probe's material point, at its exact position
   // at t = 0, and forgets what was recorded.
@@ -59,7 +59,7 @@ class ProbeRecorder {
       a.field("exact", exact);
     }
   };
-  const ProblemSetup& setup() const { return setup_; }
+  const SceneSetup& setup() const { return setup_; }
   const std::vector<double>& output_times() const { return output_times_; }
   const std::vector<LineRecord>& line_records() const { return line_records_; }
   const std::vector<double>& point_time() const { return point_time_; }
@@ -73,7 +73,7 @@ class ProbeRecorder {
   const std::vector<std::vector<double>>& history_values() const { return history_values_; }
 
  private:
-  const ProblemSetup& setup_;
+  const SceneSetup& setup_;
   std::vector<std::size_t> line_first_;  // each line's first tracer
   std::vector<LineRecord> line_records_;
   std::size_t point_first_ = 0;

@@ -10,7 +10,7 @@
 #include "solver/io/state_archive.hpp"
 #include "solver/stepper.hpp"
 #include "solver/time_loop.hpp"
-#include "tools/app/scene.hpp"
+#include "tools/app/scene/scene.hpp"
 
 namespace mpmvv::app {
 

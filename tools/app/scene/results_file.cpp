@@ -168,7 +168,7 @@ void write_particles(h5::Group& root, const Particles& P) {
 }
 
 void write_probes(h5::Group& probes, const ProbeRecorder& r) {
-  const ProblemSetup& setup = r.setup();
+  const SceneSetup& setup = r.setup();
   const std::vector<double>& output_times = r.output_times();
   const std::size_t outputs = output_times.size();
   for (std::size_t k = 0; k < setup.lines.size(); ++k) {
@@ -276,7 +276,7 @@ void write_settling(h5::Group& root, const SettlingWatch& watch, const Settling&
   g.set_attribute("description",
                   watch.relaxes()
                       ? "how far the end still is from the static state the damped run relaxes to "
-                        "(tools/app/settling.hpp): what the particles (displacement [m], RMS over the body; strain, "
+                        "(tools/app/scene/settling.hpp): what the particles (displacement [m], RMS over the body; strain, "
                         "RMS of the symmetric part of F's change) and each error norm read at the end (norms, in "
                         "its unit) moved over the last interval of 1 / decay_rate from kept_time, over "
                         "exp(decay_rate (end - kept_time)) - 1"

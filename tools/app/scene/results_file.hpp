@@ -12,9 +12,9 @@
 #include "solver/model.hpp"
 #include "tools/app/config.hpp"
 #include "tools/app/fault.hpp"
-#include "tools/app/health.hpp"
-#include "tools/app/scene.hpp"
-#include "tools/app/settling.hpp"
+#include "tools/app/scene/health.hpp"
+#include "tools/app/scene/scene.hpp"
+#include "tools/app/scene/settling.hpp"
 
 namespace mpmvv::app {
 

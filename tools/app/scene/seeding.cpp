@@ -36,7 +36,7 @@ std::vector<Vec2> joined_outline(const Piece& piece, const Piece& sliver, double
   return out;
 }
 
-std::vector<Piece> pieces_of_cell(const ProblemSetup& setup, const SeedingPlan& plan, int i, int j) {
+std::vector<Piece> pieces_of_cell(const SceneSetup& setup, const SeedingPlan& plan, int i, int j) {
   const GridGeometry& grid = setup.grid;
   const int ppd = plan.particles_per_direction;
   const double spacing = grid.h / ppd;
@@ -90,7 +90,7 @@ std::vector<Piece> pieces_of_cell(const ProblemSetup& setup, const SeedingPlan& 
 
 }  // namespace
 
-Seeded seed_particles(const ProblemSetup& setup, const SeedingPlan& plan, Particles& P) {
+Seeded seed_particles(const SceneSetup& setup, const SeedingPlan& plan, Particles& P) {
   const GridGeometry& grid = setup.grid;
   Seeded seeded;
   std::vector<Piece> pieces;
@@ -145,7 +145,7 @@ Seeded seed_particles(const ProblemSetup& setup, const SeedingPlan& plan, Partic
   return seeded;
 }
 
-void refuse_what_cannot_fit(const ProblemSetup& setup, const Config& config) {
+void refuse_what_cannot_fit(const SceneSetup& setup, const Config& config) {
   const GridGeometry& g = setup.grid;
   double area = (g.upper() - g.origin).prod();
 #ifdef MPMVV_HAVE_CGAL

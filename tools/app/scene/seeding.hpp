@@ -7,7 +7,7 @@
 
 #include "solver/model.hpp"
 #include "tools/app/config.hpp"
-#include "tools/app/mms_scene.hpp"
+#include "tools/app/scene/setup.hpp"
 
 namespace mpmvv::app {
 
@@ -32,7 +32,7 @@ struct Seeded {
 // body. Each starts in the exact state at t = 0, from the same definition as
 // the force. In r-z a particle's volume is per radian: the integral of r over
 // its area.
-Seeded seed_particles(const ProblemSetup& setup, const SeedingPlan& plan, Particles& P);
+Seeded seed_particles(const SceneSetup& setup, const SeedingPlan& plan, Particles& P);
 
 // The memory the case will hold, estimated before anything is allocated: the
 // particles (at most about 400 bytes each with the stencils a step stores and
@@ -41,6 +41,6 @@ Seeded seed_particles(const ProblemSetup& setup, const SeedingPlan& plan, Partic
 // per node, and a scatter buffer of 5 doubles per node for each thread). A
 // case that cannot fit in the machine's memory is refused (ConfigError),
 // naming the keys that set it, rather than ending in an allocation failure.
-void refuse_what_cannot_fit(const ProblemSetup& setup, const Config& config);
+void refuse_what_cannot_fit(const SceneSetup& setup, const Config& config);
 
 }  // namespace mpmvv::app

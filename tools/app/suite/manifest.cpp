@@ -145,7 +145,7 @@ std::optional<CaseState> finished_state(const fs::path& results, const SuiteCase
     CaseState s;
     s.status = root.attribute_string("status");
     if (s.status == kInterrupted) return std::nullopt;  // stopped by a signal before its end: run it again
-    // A run written before the health verdict (tools/app/health.hpp) could
+    // A run written before the health verdict (tools/app/scene/health.hpp) could
     // read "completed" with its solution lost: it runs again to be judged.
     if (!root.has_attribute("health")) return std::nullopt;
     s.exit_code = s.status == "completed" ? 0 : 1;

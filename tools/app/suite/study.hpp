@@ -12,7 +12,7 @@
 
 #include "suite.hpp"
 #include "tools/app/config.hpp"
-#include "tools/app/scene.hpp"
+#include "tools/app/scene/scene.hpp"
 
 namespace mpmvv::app::suite_file {
 

@@ -8,7 +8,7 @@
 #include <fmt/format.h>
 
 #include "mms/expanding_ring.hpp"
-#include "tools/app/mms_scene.hpp"
+#include "tools/app/scene/setup.hpp"
 
 namespace mpmvv::app {
 
@@ -37,11 +37,11 @@ std::vector<KeySpec> keys() {
        -inf, inf, false, false, {"uintah", "bubble"}},
   };
   // E = 1e7 Pa, nu = 0: lambda = 0, mu = E / 2; rho_0 = 1000.
-  return problem_keys(std::move(k), own, material_keys("neo-hookean", 0.0, 5e6, 1000.0));
+  return scene_keys(std::move(k), own, material_keys("neo-hookean", 0.0, 5e6, 1000.0));
 }
 
-ProblemSetup setup(const Config& c) {
-  ProblemSetup s;
+SceneSetup setup(const Config& c) {
+  SceneSetup s;
   s.material = material_from(c);
   s.geometry = Geometry::plane_strain;
   const double ri = c.real("inner_radius"), ro = c.real("outer_radius");
@@ -94,7 +94,7 @@ ProblemSetup setup(const Config& c) {
 
 }  // namespace
 
-MmsProblem expanding_ring_problem() {
+SceneType expanding_ring_scene() {
   return {"expanding-ring", "expanding ring in plane strain, radial motion (PROBLEMS.md section 2a)", keys, setup};
 }
 

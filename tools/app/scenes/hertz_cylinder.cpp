@@ -26,8 +26,8 @@
 
 #include "analytic/hertz.hpp"
 #include "analytic/quasi_static.hpp"
-#include "tools/app/mms_scene.hpp"
-#include "tools/app/problems/quasi_static.hpp"
+#include "tools/app/scene/setup.hpp"
+#include "tools/app/scenes/quasi_static.hpp"
 
 namespace mpmvv::app {
 
@@ -165,8 +165,8 @@ struct HertzRecord {
   AxisReading axis;  // at the last output
 };
 
-ProblemSetup setup(const Config& c) {
-  ProblemSetup s;
+SceneSetup setup(const Config& c) {
+  SceneSetup s;
   s.material = material_from(c);
   if (!std::holds_alternative<LinearElastic>(s.material))
     c.reject("material", "Hertz theory is small-strain linear elasticity: use linear-elastic");
@@ -297,7 +297,7 @@ ProblemSetup setup(const Config& c) {
 
 }  // namespace
 
-MmsProblem hertz_cylinder_problem() {
+SceneType hertz_cylinder_scene() {
   return {"hertz-cylinder",
           "rigid cylinder pressed into a steel plate, plane strain: contact half-width and pressure against Hertz "
           "(PROBLEMS.md section 4)",

@@ -1,5 +1,5 @@
 // How far a run that settles to a static state (a load ramped slowly, then
-// held: problems/quasi_static.hpp) still is from it at its end, written to
+// held: scenes/quasi_static.hpp) still is from it at its end, written to
 // the results file as the measurements settling_displacement and
 // settling_strain, which the report and the gate compare errors with
 // (reports/results.py: settling_scale). An error no larger than what the

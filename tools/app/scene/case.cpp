@@ -1,8 +1,8 @@
 // A case of a scene with an exact solution: the body seeded in the exact
 // state at t = 0, the solver stages the scene names, and, as the run goes,
 // the probes, the error norms and the monitors of its health, written to the
-// results file at its end. What is particular to a scene is its ProblemSetup
-// (tools/app/problems/); everything here is shared.
+// results file at its end. What is particular to a scene is its SceneSetup
+// (tools/app/scenes/); everything here is shared.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -17,7 +17,7 @@
 #include "results_file.hpp"
 #include "seeding.hpp"
 #include "solver/explicit_stepper.hpp"
-#include "tools/app/mms_scene.hpp"
+#include "setup.hpp"
 #ifdef MPMVV_HAVE_SUNDIALS
 #include "solver/implicit/static_stepper.hpp"
 #endif
@@ -26,10 +26,10 @@ namespace mpmvv::app {
 
 namespace {
 
-class MmsCase final : public SceneCase, private RunObserver {
+class Case final : public SceneCase, private RunObserver {
  public:
-  MmsCase(const Config& config, const MmsProblem& problem)
-      : config_(config), setup_(problem.setup(config)), options_(solver_options(config)),
+  Case(const Config& config, const SceneType& type)
+      : config_(config), setup_(type.setup(config)), options_(solver_options(config)),
         loop_(time_loop_options(config)), probes_(setup_) {
     options_.geometry = setup_.geometry;
     exact_seeding_ = config_.text("seeding") == "exact";
@@ -289,7 +289,7 @@ class MmsCase final : public SceneCase, private RunObserver {
     if (!setup_.extra_error_names.empty()) {
       const std::vector<double> extra = setup_.extra_errors(t, probes_.record(s));
       if (extra.size() != setup_.extra_error_names.size())
-        throw std::logic_error("a problem's extra errors do not match their names");
+        throw std::logic_error("a scene's extra errors do not match their names");
       for (std::size_t k = 0; k < extra.size(); ++k) errors_.columns[column + k].second.push_back(extra[k]);
     }
   }
@@ -298,7 +298,7 @@ class MmsCase final : public SceneCase, private RunObserver {
   Fault fault_;
   bool exact_seeding_ = false;
   Seeded seeded_;
-  ProblemSetup setup_;
+  SceneSetup setup_;
   SolverOptions options_;
   TimeLoopOptions loop_;
   std::unique_ptr<Stepper> stepper_;
@@ -314,8 +314,8 @@ class MmsCase final : public SceneCase, private RunObserver {
 
 }  // namespace
 
-std::unique_ptr<SceneCase> build_mms_case(const Config& config, const MmsProblem& problem) {
-  return std::make_unique<MmsCase>(config, problem);
+std::unique_ptr<SceneCase> SceneType::build(const Config& config) const {
+  return std::make_unique<Case>(config, *this);
 }
 
 }  // namespace mpmvv::app

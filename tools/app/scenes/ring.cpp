@@ -8,7 +8,7 @@
 #include <fmt/format.h>
 
 #include "mms/ring.hpp"
-#include "tools/app/mms_scene.hpp"
+#include "tools/app/scene/setup.hpp"
 
 namespace mpmvv::app {
 
@@ -42,10 +42,10 @@ std::vector<KeySpec> keys() {
       force_quadrature_key(),
       body_force_key(kClosedForm),
   };
-  return problem_keys(std::move(k), ring, material_keys("neo-hookean", 577.0, 385.0, 1000.0));
+  return scene_keys(std::move(k), ring, material_keys("neo-hookean", 577.0, 385.0, 1000.0));
 }
 
-ProblemSetup setup(const Config& c) {
+SceneSetup setup(const Config& c) {
   mms::RingParameters p;
   p.inner_radius = c.real("inner_radius");
   p.outer_radius = c.real("outer_radius");
@@ -55,7 +55,7 @@ ProblemSetup setup(const Config& c) {
   p.mu = c.real("mu");
   p.density = c.real("density");
 
-  ProblemSetup s;
+  SceneSetup s;
   s.material = material_from(c);
   s.geometry = Geometry::plane_strain;
   const double domain = c.real("domain");
@@ -141,7 +141,7 @@ ProblemSetup setup(const Config& c) {
 
 }  // namespace
 
-MmsProblem ring_problem() {
+SceneType ring_scene() {
   return {"ring", "ring MMS: circles of a ring turned by alpha = g(t) h(R) (PROBLEMS.md section 1)", keys, setup};
 }
 

@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "analytic/vibrating_bar.hpp"
-#include "tools/app/mms_scene.hpp"
+#include "tools/app/scene/setup.hpp"
 #include "vibrating_strip.hpp"
 
 namespace mpmvv::app {
@@ -25,11 +25,11 @@ std::vector<KeySpec> keys() {
       {"probe_points", KeyKind::integer, std::int64_t(51), "material points on the probe line", 2, 100000},
   };
   // Steel, E = 207 GPa, nu = 0.3.
-  return problem_keys(std::move(k), own, material_keys("linear-elastic", 119.42e9, 79.615e9, 7850.0));
+  return scene_keys(std::move(k), own, material_keys("linear-elastic", 119.42e9, 79.615e9, 7850.0));
 }
 
-ProblemSetup setup(const Config& c) {
-  ProblemSetup s;
+SceneSetup setup(const Config& c) {
+  SceneSetup s;
   s.material = material_from(c);
   s.geometry = Geometry::plane_strain;
   s.force_free = true;
@@ -46,7 +46,7 @@ ProblemSetup setup(const Config& c) {
 
 }  // namespace
 
-MmsProblem vibrating_bar_problem() {
+SceneType vibrating_bar_scene() {
   return {"vibrating-bar", "axial vibration of a fixed-free bar, first mode, no forcing (PROBLEMS.md section 5)", keys,
           setup};
 }

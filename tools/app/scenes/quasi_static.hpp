@@ -26,13 +26,13 @@ struct QuasiStatic {
   double ramp_time;  // T [s]
   double damping;    // zeta [1/s]
 };
-struct ProblemSetup;
+struct SceneSetup;
 // From the keys and the body's lowest mode's angular frequency; rejects an end
 // time that leaves the body no time to settle after the ramp (less than half
 // the ramp). Marks the scene's setup as one that settles (its smooth_until,
 // the ramp's end, and its settling body, with the small-strain shear modulus).
 QuasiStatic quasi_static_from(const Config& c, double lowest_angular_frequency, double shear_modulus,
-                              ProblemSetup& s);
+                              SceneSetup& s);
 
 // Nodes of the grid column through x (or row through y), which must be a node line.
 std::vector<std::size_t> node_column(const GridGeometry& grid, double x);
@@ -40,7 +40,7 @@ std::vector<std::size_t> node_row(const GridGeometry& grid, double y);
 
 // The bar's probes [0, L] x [0, half]: the line along it at Y = half / 2
 // (x-displacement) and the top's middle point (y-displacement).
-void add_bar_probes(ProblemSetup& s, double L, double half, int points);
+void add_bar_probes(SceneSetup& s, double L, double half, int points);
 
 // Reference-volume-weighted means over the particles whose reference position
 // lies in a region.

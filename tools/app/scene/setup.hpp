@@ -1,7 +1,9 @@
-// Scenes of manufactured solutions: a body in its reference configuration, the
-// exact solution that moves it, the body force derived from it, and the probes
-// where the error is measured. Each problem (tools/app/problems/) says what is
-// particular to it; seeding, initial state, probes and norms are shared here.
+// What is particular to a scene (SceneSetup): a body in its reference
+// configuration, the exact solution that moves it (a manufactured solution
+// under its derived body force, or a classical one reached by boundary
+// conditions), and the probes where the error is measured; with the keys
+// every scene shares. Each scene's file in tools/app/scenes/ fills one in;
+// seeding, initial state, probes, norms and health are shared (scene/).
 #pragma once
 
 #include <functional>
@@ -57,16 +59,16 @@ struct ProbeCircle {
 
 using Measurements = std::vector<std::pair<std::string, double>>;
 
-// What a problem's measurements read at the end of a run.
+// What a scene's measurements read at the end of a run.
 struct RunRecord {
   const std::vector<double>& point_time;                 // after every step
   const std::vector<std::vector<double>>& point_values;  // per probe point, at those times
   const Stepper& stepper;
 };
 
-// Everything particular to one problem: a manufactured solution under its
+// Everything particular to one scene: a manufactured solution under its
 // derived force, or a classical exact solution reached by boundary conditions.
-struct ProblemSetup {
+struct SceneSetup {
   std::shared_ptr<const mms::ExactSolution> solution;
   MaterialModel material;
   // A second material in the same body (soft against stiff): the particles
@@ -95,7 +97,7 @@ struct ProblemSetup {
   // manufactured problems. `loading` says what they are, for the results file.
   std::function<SceneStages(const Particles&, const GridGeometry&)> stages;
   std::string loading;
-  // Error columns of the problem's own, computed at every output time from
+  // Error columns of the scene's own, computed at every output time from
   // the run so far (the stepper's state, the probe points' histories), after
   // the probe and particle norms.
   std::vector<std::string> extra_error_names;
@@ -103,14 +105,14 @@ struct ProblemSetup {
   // Scalars measured at the end of a run (name, value), e.g. a period from the
   // first probe point's history, or the mean strain of the bar's middle.
   std::function<Measurements(const RunRecord&)> measure;
-  // False when the problem's exact solution is not a motion of the body (Hertz
+  // False when the scene's exact solution is not a motion of the body (Hertz
   // contact): the particle displacement norms are left out of /errors.
   bool exact_motion = true;
   // Scalars recorded after every step (e.g. load and approach), written under
   // /probes/history with the time.
   std::vector<std::string> history_names;
   std::function<std::vector<double>(double t, const Stepper&)> history;
-  // Writes what the problem gathered itself under /probes (e.g. pressure profiles).
+  // Writes what the scene gathered itself under /probes (e.g. pressure profiles).
   std::function<void(h5::Group& probes)> write_extra;
   // The motion is analytic in time before this (a load ramp is constant after
   // it): `mms check` draws its times below it. Infinite: everywhere.
@@ -119,30 +121,17 @@ struct ProblemSetup {
   // shows it), used instead of automatic differentiation for speed; absent
   // otherwise.
   std::shared_ptr<mms::ForceField> fast_body_force;
-  // A scene that settles to a static state (problems/quasi_static.hpp): what
+  // A scene that settles to a static state (scenes/quasi_static.hpp): what
   // the results file's measurements settling_displacement and settling_strain,
   // how far its end still is from that state, are measured from (settling.hpp).
   // Absent: a dynamic scene.
   std::optional<SettlingBody> settling;
 };
 
-struct MmsProblem {
-  std::string name;
-  std::string summary;
-  std::vector<KeySpec> (*keys)();
-  // Checks the keys that depend on each other (throws ConfigError) and builds.
-  ProblemSetup (*setup)(const Config&);
-};
-
-const std::vector<MmsProblem>& mms_problems();
-const MmsProblem* find_mms_problem(const std::string& name);
-
-std::unique_ptr<SceneCase> build_mms_case(const Config& config, const MmsProblem& problem);
-
-// The seeding key every manufactured problem accepts: "exact" (clipped
+// The seeding key every scene accepts: "exact" (clipped
 // volumes, CGAL) by default when built with CGAL, else "centre".
 KeySpec seeding_key();
-// The key of every problem with a manufactured body force: where a particle
+// The key of every scene with a manufactured body force: where a particle
 // samples it (mms/force_field.hpp), "centroid" by default.
 KeySpec force_quadrature_key();
 
@@ -155,11 +144,11 @@ KeySpec body_force_key(const std::string& closed_form);
 // from (throws ConfigError).
 const NeoHookean* closed_form_force(const Config& config, const MaterialModel& material, const std::string& closed_form);
 
-// A problem's keys: the solver's, its own, the seeding key and the material's.
-std::vector<KeySpec> problem_keys(std::vector<KeySpec> solver, const std::vector<KeySpec>& own,
+// A scene's keys: the solver's, its own, the seeding key and the material's.
+std::vector<KeySpec> scene_keys(std::vector<KeySpec> solver, const std::vector<KeySpec>& own,
                                   const std::vector<KeySpec>& material);
 
-// Material keys every manufactured problem accepts, with its defaults.
+// Material keys every scene accepts, with its defaults.
 std::vector<KeySpec> material_keys(const std::string& default_material, double lambda, double mu, double density);
 MaterialModel material_from(const Config& config);
 

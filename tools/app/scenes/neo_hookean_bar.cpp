@@ -21,8 +21,8 @@
 
 #include "analytic/quasi_static.hpp"
 #include "analytic/uniaxial.hpp"
-#include "tools/app/mms_scene.hpp"
-#include "tools/app/problems/quasi_static.hpp"
+#include "tools/app/scene/setup.hpp"
+#include "tools/app/scenes/quasi_static.hpp"
 
 namespace mpmvv::app {
 
@@ -47,8 +47,8 @@ std::vector<KeySpec> keys() {
   return static_scene_keys(std::move(k), own, material_keys("neo-hookean", 577.0, 385.0, 1000.0));
 }
 
-ProblemSetup setup(const Config& c) {
-  ProblemSetup s;
+SceneSetup setup(const Config& c) {
+  SceneSetup s;
   s.material = material_from(c);
   const auto* neo = std::get_if<NeoHookean>(&s.material);
   if (!neo) c.reject("material", "the finite-strain bar's exact solution is for the neo-hookean material");
@@ -143,7 +143,7 @@ ProblemSetup setup(const Config& c) {
 
 }  // namespace
 
-MmsProblem neo_hookean_bar_problem() {
+SceneType neo_hookean_bar_scene() {
   return {"neo-hookean-bar",
           "neo-Hookean bar under a dead load to a stretch of 1.5 (or 0.5), plane strain, against the exact "
           "homogeneous state (PROBLEMS.md section 5)",

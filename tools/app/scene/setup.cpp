@@ -1,4 +1,4 @@
-#include "mms_scene.hpp"
+#include "setup.hpp"
 
 #include <cmath>
 #include <limits>
@@ -60,7 +60,7 @@ const NeoHookean* closed_form_force(const Config& c, const MaterialModel& materi
   return solid;
 }
 
-std::vector<KeySpec> problem_keys(std::vector<KeySpec> k, const std::vector<KeySpec>& own,
+std::vector<KeySpec> scene_keys(std::vector<KeySpec> k, const std::vector<KeySpec>& own,
                                   const std::vector<KeySpec>& material) {
   k.insert(k.end(), own.begin(), own.end());
   k.push_back(seeding_key());
@@ -104,7 +104,7 @@ std::vector<Vec2> points_on_segment(const Vec2& a, const Vec2& b, int count) {
   return out;
 }
 
-void ProblemSetup::body_is_rectangle(const Vec2& lower, const Vec2& upper) {
+void SceneSetup::body_is_rectangle(const Vec2& lower, const Vec2& upper) {
   contains = [lower, upper](const Vec2& X) {
     return X.x() >= lower.x() && X.x() <= upper.x() && X.y() >= lower.y() && X.y() <= upper.y();
   };
@@ -113,7 +113,7 @@ void ProblemSetup::body_is_rectangle(const Vec2& lower, const Vec2& upper) {
 #endif
 }
 
-void ProblemSetup::body_is_annulus(double inner_radius, double outer_radius) {
+void SceneSetup::body_is_annulus(double inner_radius, double outer_radius) {
   contains = [inner_radius, outer_radius](const Vec2& X) {
     const double R = X.norm();
     return R >= inner_radius && R <= outer_radius;
@@ -121,40 +121,6 @@ void ProblemSetup::body_is_annulus(double inner_radius, double outer_radius) {
 #ifdef MPMVV_HAVE_CGAL
   body = Body::annulus(Vec2::Zero(), inner_radius, outer_radius);
 #endif
-}
-
-MmsProblem ring_problem();
-MmsProblem axis_aligned_problem();
-MmsProblem expanding_ring_problem();
-MmsProblem rz_cylinder_problem();
-MmsProblem vibrating_bar_problem();
-MmsProblem uniaxial_tension_problem();
-MmsProblem uniaxial_compression_problem();
-MmsProblem shear_problem();
-MmsProblem hertz_cylinder_problem();
-#ifdef MPMVV_HAVE_SUNDIALS
-MmsProblem neo_hookean_bar_problem();
-MmsProblem layered_bar_problem();
-#endif
-
-const std::vector<MmsProblem>& mms_problems() {
-  static const std::vector<MmsProblem> problems = [] {
-    std::vector<MmsProblem> p = {ring_problem(),          axis_aligned_problem(),        expanding_ring_problem(),
-                                 rz_cylinder_problem(),   vibrating_bar_problem(),       uniaxial_tension_problem(),
-                                 uniaxial_compression_problem(), shear_problem(), hertz_cylinder_problem()};
-#ifdef MPMVV_HAVE_SUNDIALS
-    p.push_back(neo_hookean_bar_problem());  // its exact state is a root found by KINSOL
-    p.push_back(layered_bar_problem());      // its frequency too
-#endif
-    return p;
-  }();
-  return problems;
-}
-
-const MmsProblem* find_mms_problem(const std::string& name) {
-  for (const MmsProblem& p : mms_problems())
-    if (p.name == name) return &p;
-  return nullptr;
 }
 
 }  // namespace mpmvv::app

@@ -8,7 +8,7 @@
 #include <fmt/format.h>
 
 #include "mms/rz_cylinder.hpp"
-#include "tools/app/mms_scene.hpp"
+#include "tools/app/scene/setup.hpp"
 
 namespace mpmvv::app {
 
@@ -29,11 +29,11 @@ std::vector<KeySpec> keys() {
       {"period", KeyKind::real, 1.0, "T, the period of g [s]", 0.0, inf, true},
       {"probe_points", KeyKind::integer, std::int64_t(51), "material points on each probe line", 2, 100000},
   };
-  return problem_keys(std::move(k), own, material_keys("neo-hookean", 577.0, 385.0, 1000.0));
+  return scene_keys(std::move(k), own, material_keys("neo-hookean", 577.0, 385.0, 1000.0));
 }
 
-ProblemSetup setup(const Config& c) {
-  ProblemSetup s;
+SceneSetup setup(const Config& c) {
+  SceneSetup s;
   s.material = material_from(c);
   s.geometry = Geometry::axisymmetric;
   const mms::RzCylinderMotion motion{c.real("inner_radius"), c.real("outer_radius"), c.real("height"),
@@ -75,7 +75,7 @@ ProblemSetup setup(const Config& c) {
 
 }  // namespace
 
-MmsProblem rz_cylinder_problem() {
+SceneType rz_cylinder_scene() {
   return {"rz-cylinder", "pulsating cylinder in r-z, hoop terms (PROBLEMS.md section 2b)", keys, setup};
 }
 

@@ -18,8 +18,8 @@
 
 #include "analytic/quasi_static.hpp"
 #include "analytic/uniaxial.hpp"
-#include "tools/app/mms_scene.hpp"
-#include "tools/app/problems/quasi_static.hpp"
+#include "tools/app/scene/setup.hpp"
+#include "tools/app/scenes/quasi_static.hpp"
 
 namespace mpmvv::app {
 
@@ -49,8 +49,8 @@ std::vector<KeySpec> keys_with(double displacement) {
 std::vector<KeySpec> tension_keys() { return keys_with(0.8566e-6); }
 std::vector<KeySpec> compression_keys() { return keys_with(-0.8566e-6); }
 
-ProblemSetup setup(const Config& c) {
-  ProblemSetup s;
+SceneSetup setup(const Config& c) {
+  SceneSetup s;
   s.material = material_from(c);
   if (!std::holds_alternative<LinearElastic>(s.material))
     c.reject("material", "the uniaxial scenes compare with small-strain theory: use linear-elastic (the "
@@ -140,14 +140,14 @@ ProblemSetup setup(const Config& c) {
 
 }  // namespace
 
-MmsProblem uniaxial_tension_problem() {
+SceneType uniaxial_tension_scene() {
   return {"uniaxial-tension",
           "steel bar pulled 0.8566 um, plane strain, against sigma = E' eps and eps_yy = -nu' eps (PROBLEMS.md "
           "section 5)",
           tension_keys, setup};
 }
 
-MmsProblem uniaxial_compression_problem() {
+SceneType uniaxial_compression_scene() {
   return {"uniaxial-compression",
           "steel bar pushed 0.8566 um, plane strain, against sigma = E' eps and eps_yy = -nu' eps (PROBLEMS.md "
           "section 5)",

@@ -7,7 +7,7 @@
 #include <fmt/format.h>
 
 #include "mms/axis_aligned.hpp"
-#include "tools/app/mms_scene.hpp"
+#include "tools/app/scene/setup.hpp"
 
 namespace mpmvv::app {
 
@@ -29,7 +29,7 @@ std::vector<KeySpec> keys() {
       {"probe_points", KeyKind::integer, std::int64_t(51), "material points on each probe line", 2, 100000},
   };
   // mu = 3846.15 Pa and K = 8333.33 Pa (lambda = K - 2 mu / 3), rho_0 = 1: E = 1e4 Pa, c = 100 m/s.
-  return problem_keys(std::move(k), own, material_keys("neo-hookean", 5769.23, 3846.15, 1.0));
+  return scene_keys(std::move(k), own, material_keys("neo-hookean", 5769.23, 3846.15, 1.0));
 }
 
 // Young's modulus of the chosen material at small strain.
@@ -49,8 +49,8 @@ double youngs_modulus(const MaterialModel& m) {
   return mu * (3.0 * lambda + 2.0 * mu) / (lambda + mu);
 }
 
-ProblemSetup setup(const Config& c) {
-  ProblemSetup s;
+SceneSetup setup(const Config& c) {
+  SceneSetup s;
   s.material = material_from(c);
   s.geometry = Geometry::plane_strain;
   const double L = c.real("length");
@@ -89,7 +89,7 @@ ProblemSetup setup(const Config& c) {
 
 }  // namespace
 
-MmsProblem axis_aligned_problem() {
+SceneType axis_aligned_scene() {
   return {"axis-aligned", "axis-aligned small-deformation MMS on the unit square or a 1D strip (PROBLEMS.md section 3)",
           keys, setup};
 }

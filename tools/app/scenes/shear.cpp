@@ -16,8 +16,8 @@
 
 #include "analytic/quasi_static.hpp"
 #include "analytic/uniaxial.hpp"
-#include "tools/app/mms_scene.hpp"
-#include "tools/app/problems/quasi_static.hpp"
+#include "tools/app/scene/setup.hpp"
+#include "tools/app/scenes/quasi_static.hpp"
 
 namespace mpmvv::app {
 
@@ -40,8 +40,8 @@ std::vector<KeySpec> keys() {
   return static_scene_keys(std::move(k), own, material_keys("linear-elastic", 1.194230769e11, 7.96153846e10, 7850.0));
 }
 
-ProblemSetup setup(const Config& c) {
-  ProblemSetup s;
+SceneSetup setup(const Config& c) {
+  SceneSetup s;
   s.material = material_from(c);
   if (!std::holds_alternative<LinearElastic>(s.material))
     c.reject("material", "the shear scene compares with small-strain theory: use linear-elastic");
@@ -119,7 +119,7 @@ ProblemSetup setup(const Config& c) {
 
 }  // namespace
 
-MmsProblem shear_problem() {
+SceneType shear_scene() {
   return {"shear", "simple shear of a steel block, gamma = 1.96e-4, against tau = G gamma (PROBLEMS.md section 5)",
           keys, setup};
 }

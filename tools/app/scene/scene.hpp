@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "config.hpp"
-#include "fault.hpp"
+#include "tools/app/config.hpp"
+#include "tools/app/fault.hpp"
 #include "health.hpp"
 #include "solver/io/hdf5.hpp"
 #include "solver/model.hpp"
@@ -91,15 +91,21 @@ class SceneCase {
   }
 };
 
+struct SceneSetup;  // setup.hpp
+
+// A scene: its name, what it is, its keys, and what is particular to it.
 struct SceneType {
   std::string name;
   std::string summary;
   std::vector<KeySpec> (*keys)();
-  // Checks the rules that tie keys together and builds the case; throws
-  // ConfigError naming the key.
-  std::function<std::unique_ptr<SceneCase>(const Config&)> build;
+  // Checks the keys that depend on each other (throws ConfigError naming the
+  // key) and sets the scene up: body, material, exact solution, probes, loads.
+  SceneSetup (*setup)(const Config&);
+  // A case of the scene, ready to run (case.cpp); throws as `setup` does.
+  std::unique_ptr<SceneCase> build(const Config& config) const;
 };
 
+// Every scene (tools/app/scenes/registry.cpp), and the one of a name (null: none).
 const std::vector<SceneType>& scene_types();
 const SceneType* find_scene_type(const std::string& name);
 

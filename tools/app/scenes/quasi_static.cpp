@@ -6,7 +6,7 @@
 
 #include <fmt/format.h>
 
-#include "tools/app/mms_scene.hpp"
+#include "tools/app/scene/setup.hpp"
 
 namespace mpmvv::app {
 
@@ -33,10 +33,10 @@ std::vector<KeySpec> static_scene_keys(std::vector<KeySpec> k, const std::vector
        "grid damping (eq. 1.65, zeta = ratio x 2 omega_1; 1 damps the lowest mode critically, 0: none)", 0.0, 100.0},
   };
   k.insert(k.end(), load.begin(), load.end());
-  return problem_keys(std::move(k), {}, material);
+  return scene_keys(std::move(k), {}, material);
 }
 
-void add_bar_probes(ProblemSetup& s, double L, double half, int points) {
+void add_bar_probes(SceneSetup& s, double L, double half, int points) {
   ProbeLine line{"line_axis", ProbeQuantity::displacement_x, "reference_x", {}, {}, std::nullopt};
   line.reference = points_on_segment(Vec2(0.0, 0.5 * half), Vec2(L, 0.5 * half), points);
   for (const Vec2& X : line.reference) line.parameter.push_back(X.x());
@@ -44,7 +44,7 @@ void add_bar_probes(ProblemSetup& s, double L, double half, int points) {
   s.points.push_back({"point_top_middle", ProbeQuantity::displacement_y, Vec2(0.5 * L, half)});
 }
 
-QuasiStatic quasi_static_from(const Config& c, double omega, double shear_modulus, ProblemSetup& s) {
+QuasiStatic quasi_static_from(const Config& c, double omega, double shear_modulus, SceneSetup& s) {
   const double period = 2.0 * std::numbers::pi / omega;
   const double ramp_time = c.real("ramp_periods") * period;
   if (c.real("end_time") < 1.5 * ramp_time)

@@ -10,7 +10,7 @@
 
 namespace mpmvv::app {
 
-void set_up_vibrating_strip(ProblemSetup& s, double length, int cells, int probe_points, double exact_period,
+void set_up_vibrating_strip(SceneSetup& s, double length, int cells, int probe_points, double exact_period,
                             double exact_amplitude) {
   const double L = length;
   const double h = L / cells;

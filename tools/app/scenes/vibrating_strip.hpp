@@ -6,14 +6,14 @@
 // measured against the exact ones.
 #pragma once
 
-#include "tools/app/mms_scene.hpp"
+#include "tools/app/scene/setup.hpp"
 
 namespace mpmvv::app {
 
 // Sets the grid (cells along the bar), the body, the probes, the error
 // columns error_period and error_amplitude (|measured / exact - 1|, NaN until
 // the history spans a period) and the measurements of `s`.
-void set_up_vibrating_strip(ProblemSetup& s, double length, int cells, int probe_points, double exact_period,
+void set_up_vibrating_strip(SceneSetup& s, double length, int cells, int probe_points, double exact_period,
                             double exact_amplitude);
 
 }  // namespace mpmvv::app

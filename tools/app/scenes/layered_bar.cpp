@@ -13,7 +13,7 @@
 #include <numbers>
 
 #include "analytic/layered_bar.hpp"
-#include "tools/app/mms_scene.hpp"
+#include "tools/app/scene/setup.hpp"
 #include "vibrating_strip.hpp"
 
 namespace mpmvv::app {
@@ -40,7 +40,7 @@ std::vector<KeySpec> keys() {
       {"probe_points", KeyKind::integer, std::int64_t(51), "material points on the probe line", 2, 100000},
   };
   // Steel, E = 207 GPa, nu = 0.3.
-  return problem_keys(std::move(k), own, material_keys("linear-elastic", 119.42e9, 79.615e9, 7850.0));
+  return scene_keys(std::move(k), own, material_keys("linear-elastic", 119.42e9, 79.615e9, 7850.0));
 }
 
 // The material with every constant times `factor`: the same model, stiffer or softer.
@@ -88,8 +88,8 @@ class LayeredSolution final : public mms::ExactSolution {
   double interface_, length_;
 };
 
-ProblemSetup setup(const Config& c) {
-  ProblemSetup s;
+SceneSetup setup(const Config& c) {
+  SceneSetup s;
   s.material = material_from(c);
   s.second_material = scaled(s.material, c.real("stiffness_ratio"));
   s.geometry = Geometry::plane_strain;
@@ -116,7 +116,7 @@ ProblemSetup setup(const Config& c) {
 
 }  // namespace
 
-MmsProblem layered_bar_problem() {
+SceneType layered_bar_scene() {
   return {"layered-bar",
           "axial vibration of a fixed-free bar of a stiff and a soft layer, first mode, no forcing (PROBLEMS.md "
           "section 6: stiffness contrast)",

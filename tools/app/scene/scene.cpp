@@ -1,7 +1,5 @@
 #include "scene.hpp"
 
-#include "mms_scene.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <ostream>
@@ -11,23 +9,6 @@
 #include <fmt/format.h>
 
 namespace mpmvv::app {
-
-// Every manufactured problem is a scene of its own name.
-const std::vector<SceneType>& scene_types() {
-  static const std::vector<SceneType> types = [] {
-    std::vector<SceneType> t;
-    for (const MmsProblem& p : mms_problems())
-      t.push_back({p.name, p.summary, p.keys, [&p](const Config& c) { return build_mms_case(c, p); }});
-    return t;
-  }();
-  return types;
-}
-
-const SceneType* find_scene_type(const std::string& name) {
-  for (const SceneType& t : scene_types())
-    if (t.name == name) return &t;
-  return nullptr;
-}
 
 std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_time,
                                  std::vector<double> default_output_times) {
