@@ -171,12 +171,17 @@ TEST_F(SceneFile, SceneMustBeNamedAndKnown) {
 }
 
 // The shipped ring scene is valid and every key it names comes from it.
-TEST_F(SceneFile, ShippedRingSceneLoads) {
-  const std::string path = std::string(MPMVV_SOURCE_DIR) + "/suites/scenes/ring.toml";
-  const Config c = load(path);
-  EXPECT_EQ(c.scene(), "ring");
-  EXPECT_MENTIONS(c.origin("cells").source, "ring.toml:");
-  EXPECT_MENTIONS(c.origin("output_times").source, "ring.toml:");
+TEST_F(SceneFile, ShippedRingScenesLoad) {
+  // ring.toml sets nothing but its scene: every key comes from its default.
+  const Config ring = load(std::string(MPMVV_SOURCE_DIR) + "/suites/scenes/ring.toml");
+  EXPECT_EQ(ring.scene(), "ring");
+  EXPECT_EQ(ring.origin("cells").source, "default");
+  // stiff-vortex.toml is the ring with the keys it sets, each from its line.
+  const Config vortex = load(std::string(MPMVV_SOURCE_DIR) + "/suites/scenes/stiff-vortex.toml");
+  EXPECT_EQ(vortex.scene(), "ring");
+  EXPECT_MENTIONS(vortex.origin("cells").source, "stiff-vortex.toml:");
+  EXPECT_MENTIONS(vortex.origin("output_times").source, "stiff-vortex.toml:");
+  EXPECT_EQ(vortex.integer("cells"), 30);
 }
 
 // The resolved configuration a run stores (to_toml) reads back to the same
@@ -294,3 +299,23 @@ TEST(SceneRules, CrossKeyRulesNameTheKey) {
 }
 
 }  // namespace
+
+// A scene's defaults are written once, in its keys (tools/app/scenes/): a
+// shipped scene file sets a key only to a value other than its default, so
+// that a default changed in the code is the default every file runs with.
+TEST(SceneFiles, SetOnlyWhatDiffersFromTheDefaults) {
+  int files = 0;
+  for (const fs::directory_entry& entry : fs::directory_iterator(std::string(MPMVV_SOURCE_DIR) + "/suites/scenes")) {
+    if (entry.path().extension() != ".toml") continue;
+    ++files;
+    const Config file = load(entry.path().string());
+    const Config defaults(file.scene(), *registered_keys(file.scene()));
+    const toml::table table = toml::parse_file(entry.path().string());
+    for (const auto& [key, node] : table) {
+      if (key.str() == "scene") continue;
+      EXPECT_NE(file.value(std::string(key.str())), defaults.value(std::string(key.str())))
+          << entry.path().filename().string() << " sets " << key.str() << " to its default";
+    }
+  }
+  EXPECT_GE(files, 12);
+}
