@@ -10,8 +10,8 @@ Usage: /usr/bin/python3 reports/convergence_table.py RESULTS.h5 [RESULTS.h5 ...]
 """
 import sys
 
-from results import read_results_file
-from series import pair_order_cell
+from .results import read_results_file
+from .series import pair_order_cell
 
 # The /errors columns tabulated, by their heading.
 NORMS = {"L1 Theta=0": "L1_theta0", "L1 +45": "L1_theta_plus45", "L1 -45": "L1_theta_minus45",

@@ -5,8 +5,8 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-import figures
-from report_rows import METHOD_KEYS
+from . import figures
+from .report_rows import METHOD_KEYS
 
 
 @dataclass(frozen=True)

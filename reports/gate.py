@@ -44,9 +44,9 @@ import math
 import sys
 from dataclasses import dataclass
 
-from orders import OrderFit, least_squares_order
-from results import SuiteDirectoryError, exact_signal_fraction, read_suite
-from series import (DEFAULT_REFINE_KEY, Series, floor_kind, floor_text, matches, refinement_series,
+from .orders import OrderFit, least_squares_order
+from .results import SuiteDirectoryError, exact_signal_fraction, read_suite
+from .series import (DEFAULT_REFINE_KEY, Series, floor_kind, floor_text, matches, refinement_series,
                     roundoff_checks, series_levels, size_name, usable)
 
 TRIVIAL_SIGNAL = 0.05   # an exact signal below this fraction of its largest is warned about

@@ -22,7 +22,7 @@ A reference names one or more studies, the scene keys that identify a row
 import math
 from dataclasses import dataclass
 
-from series import canonical_value
+from .series import canonical_value
 
 
 @dataclass(frozen=True)

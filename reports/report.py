@@ -23,13 +23,13 @@ from dataclasses import dataclass
 from datetime import datetime
 from pathlib import Path
 
-import gate
-import orders
-from report_figures import study_figures
-from report_rows import ORDERS_CSV_COLUMNS, gci_rows, order_rows, stored_norm_check
-from report_tables import (case_table, expectation_table, gci_table, measurement_sections, orders_table,
+from . import gate
+from . import orders
+from .report_figures import study_figures
+from .report_rows import ORDERS_CSV_COLUMNS, gci_rows, order_rows, stored_norm_check
+from .report_tables import (case_table, expectation_table, gci_table, measurement_sections, orders_table,
                            reference_sections, write_gci_csv, write_orders_csv)
-from results import SuiteDirectoryError, read_suite
+from .results import SuiteDirectoryError, read_suite
 
 
 @dataclass(frozen=True)

@@ -4,14 +4,14 @@ scene-specific ones (scene_figures.py) where the results files hold their data."
 import math
 import textwrap
 
-import figures
-import norms
-from figure_parts import FigureEntry, saved, sort_value, split_label, time_text
-from report_rows import error_columns, line_quantities, series_end_time, study_series
-from results import lookup_error
-from scene_figures import (contact_pressure_figure, health_figure, history_figure, load_approach_figure, profile_figure,
+from . import figures
+from . import norms
+from .figure_parts import FigureEntry, saved, sort_value, split_label, time_text
+from .report_rows import error_columns, line_quantities, series_end_time, study_series
+from .results import lookup_error
+from .scene_figures import (contact_pressure_figure, health_figure, history_figure, load_approach_figure, profile_figure,
                            spectrum_figure)
-from series import floor_text, size_name
+from .series import floor_text, size_name
 
 
 def series_styles(all_series):

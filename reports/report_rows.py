@@ -6,10 +6,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-import norms
-import orders
-from results import read_point_history, read_probe_lines
-from series import (DEFAULT_REFINE_KEY, floor_kind, refined_size, refinement_series, roundoff_checks, series_levels,
+from . import norms
+from . import orders
+from .results import read_point_history, read_probe_lines
+from .series import (DEFAULT_REFINE_KEY, floor_kind, refined_size, refinement_series, roundoff_checks, series_levels,
                     steps_of, usable)
 
 

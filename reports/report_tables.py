@@ -6,12 +6,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-import gate
-import norms
-import references
-from report_rows import ORDERS_CSV_COLUMNS, line_quantities, order_row, study_series
-from results import lookup_error
-from series import floor_text
+from . import gate
+from . import norms
+from . import references
+from .report_rows import ORDERS_CSV_COLUMNS, line_quantities, order_row, study_series
+from .results import lookup_error
+from .series import floor_text
 
 
 @dataclass(frozen=True)

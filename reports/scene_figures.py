@@ -5,11 +5,11 @@ import math
 
 import numpy as np
 
-import figures
-import norms
-from figure_parts import FigureEntry, saved, split_label, time_text
-from report_rows import PARAMETER_LABELS
-from results import (read_contact_pressure, read_error_spectrum, read_monitors, read_point_history, read_probe_lines,
+from . import figures
+from . import norms
+from .figure_parts import FigureEntry, saved, split_label, time_text
+from .report_rows import PARAMETER_LABELS
+from .results import (read_contact_pressure, read_error_spectrum, read_monitors, read_point_history, read_probe_lines,
                      read_scene_history, relative_energy_created)
 
 

@@ -18,8 +18,8 @@ import json
 import math
 from dataclasses import dataclass
 
-from orders import pairwise_orders, roundoff_floor
-from results import error_scale, lookup_error, settling_scale
+from .orders import pairwise_orders, roundoff_floor
+from .results import error_scale, lookup_error, settling_scale
 
 DEFAULT_REFINE_KEY = "cells"
 

@@ -14,8 +14,8 @@ import argparse
 import sys
 from collections import defaultdict
 
-from results import read_results_file
-from series import pair_order_cell
+from .results import read_results_file
+from .series import pair_order_cell
 
 METHOD_ORDER = {"linear": 0, "gimp": 1, "cpdi": 2, "cpdi-exact": 3, "bspline": 4, "bspline-cubic": 5}
 

@@ -12,14 +12,13 @@ import h5py
 import numpy as np
 import pytest
 
-import gate
-import report
-import report_rows
-import report_tables
-from conftest import (RING_TIMES, ROUNDOFF_SUITE, SYNTHETIC_SUITE, roundoff_cases, synthetic_ring_cases,
+from . import gate
+from . import report_rows
+from . import report_tables
+from .conftest import (RING_TIMES, ROUNDOFF_SUITE, SYNTHETIC_SUITE, roundoff_cases, synthetic_ring_cases,
                       write_suite_directory)
-from results import error_scale, read_suite, settling_scale
-from series import Level, RoundOff, error_floor_kind, refinement_series, series_levels
+from .results import error_scale, read_suite, settling_scale
+from .series import Level, RoundOff, error_floor_kind, refinement_series, series_levels
 
 
 def run_gate(directory, capsys):

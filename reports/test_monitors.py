@@ -12,11 +12,11 @@ import h5py
 import numpy as np
 import pytest
 
-import figures
-import report
-import scene_figures
-from conftest import record_calls, write_case_results
-from results import Case, CaseResults, RunMonitors, relative_energy_created
+from . import figures
+from . import report
+from . import scene_figures
+from .conftest import record_calls, write_case_results
+from .results import Case, CaseResults, RunMonitors, relative_energy_created
 
 GOLD = Path(__file__).parent / "gold"
 INITIAL_ENERGY = 100.0

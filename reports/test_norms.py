@@ -5,9 +5,9 @@ import math
 
 import numpy as np
 
-import norms
-from conftest import write_case_results
-from results import read_case_results, read_probe_lines
+from . import norms
+from .conftest import write_case_results
+from .results import read_case_results, read_probe_lines
 
 
 def test_eq_3_1_is_the_mean_absolute_difference_at_each_time():

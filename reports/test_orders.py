@@ -7,8 +7,7 @@ import math
 import numpy as np
 import pytest
 
-import orders
-
+from . import orders
 H = [0.1, 0.05, 0.025, 0.0125]
 
 

@@ -11,15 +11,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import figures
-import gate
-import report
-import report_rows
-import report_tables
-from conftest import (HERTZ_END_TIME, HERTZ_SUITE, ROUNDOFF_SUITE, SYNTHETIC_SUITE, hertz_cases, hertz_exact_pressure,
+from . import figures
+from . import gate
+from . import report
+from . import report_rows
+from . import report_tables
+from .conftest import (HERTZ_END_TIME, HERTZ_SUITE, ROUNDOFF_SUITE, SYNTHETIC_SUITE, hertz_cases, hertz_exact_pressure,
                       hertz_half_width, hertz_load, record_calls, roundoff_cases, synthetic_ring_cases,
                       write_suite_directory)
-from results import PointHistory, read_suite
+from .results import PointHistory, read_suite
 
 GOLD = Path(__file__).parent / "gold"
 

@@ -4,10 +4,10 @@ gives none, and a stopped run is reported with its reason and time instead of
 numbers."""
 import math
 
-import convergence_table
-import study_table
-from orders import pairwise_orders
-from conftest import ROUNDOFF_SUITE, roundoff_cases, write_ring_results, write_suite_directory
+from . import convergence_table
+from . import study_table
+from .orders import pairwise_orders
+from .conftest import ROUNDOFF_SUITE, roundoff_cases, write_ring_results, write_suite_directory
 
 
 def test_observed_order_of_c_h_squared_is_two():

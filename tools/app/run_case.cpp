@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <new>
@@ -37,18 +38,28 @@ std::string version_string() {
   return fmt::format("mpmvv {} (commit {}; built with: {})", MPMVV_VERSION, MPMVV_GIT_COMMIT, MPMVV_FEATURES);
 }
 
-int run_report_tool(const std::string& script, const std::vector<std::string>& arguments, std::ostream& err) {
+int run_report_tool(const std::string& module, const std::vector<std::string>& arguments, std::ostream& err) {
   const std::string python = "/usr/bin/python3";
-  const std::string path = std::string(MPMVV_REPORTS_DIR) + "/" + script;
+  const fs::path package = MPMVV_REPORTS_DIR;  // the reports package: <root>/reports
+  const fs::path path = package / (module + ".py");
   if (!fs::exists(python)) {
     fmt::print(err, "mpmvv: {} is missing: run tools/install-deps (Debian's python3 with numpy, h5py, matplotlib)\n", python);
     return 2;
   }
-  if (!fs::exists(path)) {
-    fmt::print(err, "mpmvv: the report tools are missing ({} not found)\n", path);
+  if (!fs::exists(path) || !fs::exists(package / "__init__.py")) {
+    fmt::print(err, "mpmvv: the report tools are missing ({} not found)\n", path.string());
     return 2;
   }
-  std::vector<std::string> args = {python, path};
+  // The package is imported from the directory that holds it, ahead of any
+  // PYTHONPATH the caller set; -P keeps the working directory off the path,
+  // where a folder of the same name would shadow it.
+  const char* earlier = std::getenv("PYTHONPATH");
+  const std::string search = package.parent_path().string() + (earlier && *earlier ? std::string(":") + earlier : "");
+  if (::setenv("PYTHONPATH", search.c_str(), 1) != 0) {
+    fmt::print(err, "mpmvv: cannot set PYTHONPATH: {}\n", std::strerror(errno));
+    return 2;
+  }
+  std::vector<std::string> args = {python, "-P", "-m", package.filename().string() + "." + module};
   args.insert(args.end(), arguments.begin(), arguments.end());
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());

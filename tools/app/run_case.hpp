@@ -44,8 +44,9 @@ std::string describe_scenes();
 
 std::string version_string();
 
-// Hands over to a Python tool of reports/ under /usr/bin/python3 (which sees
-// Debian's numpy, h5py and matplotlib); returns only if it cannot start.
-int run_report_tool(const std::string& script, const std::vector<std::string>& arguments, std::ostream& err);
+// Hands over to a module of the reports package (`python3 -m reports.MODULE`)
+// under /usr/bin/python3, which sees Debian's numpy, h5py and matplotlib;
+// returns only if it cannot start.
+int run_report_tool(const std::string& module, const std::vector<std::string>& arguments, std::ostream& err);
 
 }  // namespace mpmvv::app

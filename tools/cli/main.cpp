@@ -166,9 +166,9 @@ int main(int argc, char** argv) {
   if (report_cmd->parsed()) {
     std::vector<std::string> args = {report_dir};
     if (!report_out.empty()) args.insert(args.end(), {"-o", report_out});
-    return mpmvv::app::run_report_tool("report.py", args, std::cerr);
+    return mpmvv::app::run_report_tool("report", args, std::cerr);
   }
-  if (gate_cmd->parsed()) return mpmvv::app::run_report_tool("gate.py", {gate_dir}, std::cerr);
+  if (gate_cmd->parsed()) return mpmvv::app::run_report_tool("gate", {gate_dir}, std::cerr);
   if (app.got_subcommand("scenes")) {
     std::cout << mpmvv::app::describe_scenes();
     return 0;
