@@ -45,7 +45,8 @@ import sys
 from dataclasses import dataclass
 
 from .orders import OrderFit, least_squares_order
-from .results import SuiteDirectoryError, exact_signal_fraction, read_suite
+from .results import SuiteDirectoryError, read_suite
+from .scales import exact_signal_fraction
 from .series import (DEFAULT_REFINE_KEY, Series, floor_kind, floor_text, matches, refinement_series,
                     roundoff_checks, series_levels, size_name, usable)
 

@@ -22,7 +22,7 @@ Classification of a range (the rule, applied in this order):
 * ``settling``: the run settles to a static state (dynamic relaxation, implicit
   load steps), and the error of some usable level is positive and at most what
   the run's distance from that state at the end could leave in the norm
-  (results.py: settling_scale, from the results file's /settling group): the
+  (scales.py: settling_scale, from the results file's /settling group): the
   solver's stopping point can explain it, and no order is given;
 * ``stalled``: the last pairwise order (between the two finest levels) is below
   STALLED_BELOW = 0.5: the error no longer falls with h;
@@ -54,7 +54,7 @@ order fitted through it is no evidence of how the method converges. For a
 relative error M = 1, but a strain formed as F - I near F = I (and a stress
 formed from it) is rounded to ulps of 1, not of the strain: for the error_*
 columns of a strain or stress M = 1 / |strain|, the largest |F - I| entry
-of the particles (results.py: error_scale).
+of the particles (scales.py: error_scale).
 
 Richardson extrapolation and the grid convergence index (Roache, *Verification
 and Validation in Computational Science and Engineering*, 1998, ch. 5; Roache,

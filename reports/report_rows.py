@@ -8,7 +8,7 @@ import numpy as np
 
 from . import norms
 from . import orders
-from .results import read_point_history, read_probe_lines
+from .probes import read_point_history, read_probe_lines
 from .series import (DEFAULT_REFINE_KEY, floor_kind, refined_size, refinement_series, roundoff_checks, series_levels,
                     steps_of, usable)
 
@@ -39,7 +39,7 @@ ORDERS_CSV_COLUMNS = (
                        "difference of, over the same signal: a level whose relative_error is at most this is at "
                        "round-off (reports/orders.py)"),
     ("settling", "each usable level's settling level over the same signal, the largest error the run's distance "
-                 "from its static state at the end could leave (results.py: settling_scale; NaN for a run that "
+                 "from its static state at the end could leave (scales.py: settling_scale; NaN for a run that "
                  "does not settle): a level whose relative_error is at most this is at the settling level"),
 )
 METHOD_KEYS = ("method", "scheme", "particles_per_direction", "cfl", "time_integration", "solver", "load_steps",

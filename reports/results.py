@@ -15,7 +15,8 @@ so that every report and the gate can show it instead of stopping on it.
 Only root attributes, /errors and the /measurements and /settling scalars are read up front;
 probe arrays (lines, points, the circle, /probes/contact_pressure,
 /probes/history, /probes/monitors) are read on demand for the cases that are
-plotted.
+plotted (probes.py), and the scales an error is judged against are in
+scales.py.
 """
 import json
 import math
@@ -209,7 +210,7 @@ def _read_case(directory, entry):
                 results=results, note=note)
 
 
-def _plain(value):
+def plain(value):
     if isinstance(value, bytes):
         return value.decode()
     if isinstance(value, np.generic):
@@ -221,7 +222,7 @@ def read_case_results(path):
     """Root attributes, /errors, the probe lines' quantities and the /measurements
     and /settling attributes of one results file."""
     with h5py.File(path, "r") as f:
-        attributes = {name: _plain(value) for name, value in f.attrs.items()}
+        attributes = {name: plain(value) for name, value in f.attrs.items()}
         errors_group = f.get("errors")
         errors, error_times = {}, np.zeros(0)
         if errors_group is not None:
@@ -234,18 +235,18 @@ def read_case_results(path):
                                      f"{error_times.shape}")
         line_quantities = {}
         for name, group in f.get("probes", {}).items():
-            quantity = _plain(group.attrs.get("quantity", ""))
+            quantity = plain(group.attrs.get("quantity", ""))
             if name != "circle" and quantity in group and group[quantity].ndim == 2:
                 line_quantities[name] = quantity
         measurements_group = f.get("measurements")
-        measurements = ({name: _plain(value) for name, value in measurements_group.attrs.items()}
+        measurements = ({name: plain(value) for name, value in measurements_group.attrs.items()}
                         if isinstance(measurements_group, h5py.Group) else {})
         settling_group = f.get("settling")
         settling = {}
         if isinstance(settling_group, h5py.Group):
-            settling = {name: _plain(value) for name, value in settling_group.attrs.items()}
+            settling = {name: plain(value) for name, value in settling_group.attrs.items()}
             norms_group = settling_group.get("norms")
-            settling["norms"] = ({name: _plain(value) for name, value in norms_group.attrs.items()}
+            settling["norms"] = ({name: plain(value) for name, value in norms_group.attrs.items()}
                                  if isinstance(norms_group, h5py.Group) else {})
     return CaseResults(attributes, error_times, errors, line_quantities, measurements, settling)
 
@@ -272,341 +273,3 @@ def lookup_error(case, norm, time):
     if not math.isfinite(value):
         return nan, f"{norm} is {value} at t = {time:g}"
     return value, ""
-
-
-@dataclass(frozen=True)
-class ProbeLine:
-    name: str
-    quantity: str
-    parameter: str                # e.g. reference_radius
-    positions: np.ndarray         # P values of the parameter [m]
-    time: np.ndarray              # T output times
-    simulated: np.ndarray         # T x P
-    exact: np.ndarray             # T x P
-
-
-@dataclass(frozen=True)
-class PointHistory:
-    name: str
-    quantity: str
-    reference_position: np.ndarray
-    time: np.ndarray              # S step times
-    simulated: np.ndarray
-    exact: np.ndarray
-
-
-@dataclass(frozen=True)
-class ErrorSpectrum:
-    quantity: str
-    reference_radius: float
-    time: np.ndarray              # T output times
-    amplitude: np.ndarray         # T x (M/2 + 1): one-sided amplitude of mode m of the error
-
-
-def read_probe_lines(path):
-    """Every probe line of a results file, in the file's group order."""
-    lines = []
-    with h5py.File(path, "r") as f:
-        for name, group in f.get("probes", {}).items():
-            quantity = _plain(group.attrs.get("quantity", ""))
-            if name == "circle" or quantity not in group or group[quantity].ndim != 2:
-                continue
-            parameter = next((p for p in group if p.startswith("reference_") and p != "reference_position"),
-                             "reference_position")
-            positions = np.asarray(group[parameter][:], float)
-            if positions.ndim == 2:
-                positions = np.hypot(positions[:, 0], positions[:, 1])
-            lines.append(ProbeLine(name, quantity, parameter, positions, np.asarray(group["time"][:], float),
-                                   np.asarray(group[quantity][:], float),
-                                   np.asarray(group["exact_" + quantity][:], float)))
-    return lines
-
-
-# Norms of the displacement error, measured against exact_displacement_L2.
-DISPLACEMENT_NORMS = ("particle_L1", "particle_L2", "particle_Linf")
-# /errors columns that are already relative to the exact value they measure
-# (results-format.md): their exact signal is 1, in their own unit.
-RELATIVE_NORMS = ("particle_relative_L2_integrated",)
-RELATIVE_NORM_PREFIX = "error_"
-
-
-def _exact_signal_series(case, norm):
-    """(output times, the exact signal the norm measures at each): the mean |exact|
-    on the line of an L1_<line> norm (eq. 3.1's exact values), the RMS exact
-    displacement for the particle displacement norms; None for other norms, an
-    unreadable file or a missing line."""
-    if norm.startswith("L1_"):
-        try:
-            line = next((l for l in read_probe_lines(case.results_path) if l.name == norm[3:]), None)
-        except (OSError, KeyError, ValueError, TypeError):
-            return None
-        return None if line is None else (line.time, np.mean(np.abs(line.exact), axis=1))
-    if norm in DISPLACEMENT_NORMS and "exact_displacement_L2" in case.results.errors:
-        return case.results.error_times, case.results.errors["exact_displacement_L2"]
-    return None
-
-
-def _output_index(times, time, count):
-    """The index of output time `time` among `times` (and below `count`), or None."""
-    hits = np.nonzero(np.abs(times - time) <= TIME_MATCH_TOLERANCE * max(1.0, abs(time)))[0]
-    return int(hits[0]) if hits.size and hits[0] < count else None
-
-
-def exact_signal_fraction(case, norm, time):
-    """What the exact solution gives the norm to measure at output time `time`, as
-    a fraction of its largest over the run's output times: the mean |exact| on the
-    line of an L1_<line> norm (eq. 3.1's exact values), the RMS exact displacement
-    for the particle displacement norms. None where it is not known (other norms,
-    no such output, an unreadable file). A read where the fraction is small
-    measures little: a run without the motion scores nearly the same there."""
-    series = _exact_signal_series(case, norm) if case.results is not None else None
-    if series is None:
-        return None
-    times, signal = series
-    index = _output_index(times, time, len(signal))
-    largest = float(np.max(signal)) if len(signal) else 0.0
-    if index is None or not largest > 0.0:
-        return None
-    return float(signal[index]) / largest
-
-
-def _strain_size(case):
-    """The largest in-plane |F - I| entry over the particles at the end of the run:
-    a strain, and a stress E (F - I), is formed from entries of F near 1, so its
-    rounding is ulps of 1, not of the strain. None where the file does not hold F."""
-    try:
-        with h5py.File(case.results_path, "r") as f:
-            F = f.get("particles/deformation_gradient")
-            if not isinstance(F, h5py.Dataset) or F.size == 0:
-                return None
-            F = np.asarray(F[:], float).reshape(-1, 2, 2)
-    except (OSError, KeyError, ValueError, TypeError):
-        return None
-    strain = float(np.max(np.abs(F - np.eye(2))))
-    return strain if math.isfinite(strain) and strain > 0.0 else None
-
-
-def _coordinate_size(case, norm):
-    """The size of the numbers the norm's error is a difference of: for a length
-    read off material points (x - X, |x| - |X|), the largest |X| of those points
-    (the line's, or every particle's); pi for an angle (atan2's largest value).
-    None where the file does not hold them."""
-    try:
-        with h5py.File(case.results_path, "r") as f:
-            if norm.startswith("L1_"):
-                group = f.get(f"probes/{norm[3:]}")
-                if not isinstance(group, h5py.Group):
-                    return None
-                if _plain(group.attrs.get("quantity", "")) == "angular_displacement":
-                    return math.pi
-                positions = group.get("reference_position")
-            else:
-                positions = f.get("particles/reference_position")
-            if not isinstance(positions, h5py.Dataset) or positions.size == 0:
-                return None
-            positions = np.asarray(positions[:], float).reshape(-1, 2)
-    except (OSError, KeyError, ValueError, TypeError):
-        return None
-    size = float(np.max(np.hypot(positions[:, 0], positions[:, 1])))
-    return size if math.isfinite(size) else None
-
-
-def error_scale(case, norm, time):
-    """(S, M) for the error `norm` at output time `time`: S the exact signal it
-    measures there (the mean |exact| on an L1_<line> norm's line, the RMS exact
-    displacement for particle_L1, _L2, _Linf; 1 for an error already relative to
-    its exact value: error_* and particle_relative_L2_integrated), M the size of
-    the numbers the error is a difference of (_coordinate_size; 1 for a relative
-    error, 1 / strain for a relative error of a strain or stress, _strain_size),
-    in the norm's unit. The round-off floor of reports/orders.py is
-    measured with them. None where either is not known."""
-    if case.results is None:
-        return None
-    if norm.startswith(RELATIVE_NORM_PREFIX) or norm in RELATIVE_NORMS:
-        if norm not in case.results.errors:
-            return None
-        # A strain or stress relative to its exact value is rounded to ulps of
-        # F's entries (near 1) over the strain: M = 1 / strain where it is small.
-        # (Without F in the file, 1: the floor of the ratio itself.)
-        if norm.endswith(("_strain", "_stress")):
-            strain = _strain_size(case)
-            return 1.0, 1.0 / min(strain, 1.0) if strain is not None else 1.0
-        return 1.0, 1.0
-    series = _exact_signal_series(case, norm)
-    if series is None:
-        return None
-    times, signal = series
-    index = _output_index(times, time, len(signal))
-    size = _coordinate_size(case, norm) if index is not None else None
-    if size is None or not math.isfinite(signal[index]):
-        return None
-    return float(signal[index]), size
-
-
-# A mean over a region of at least a quarter of the body is at most twice the
-# body's RMS (settling_scale).
-SETTLING_REGION_FACTOR = 2.0
-
-
-def settling_scale(case, norm, time):
-    """The largest error in `norm` that the run's stopping short of its static
-    state could leave at output time `time`, in the norm's unit, from the
-    results file's /settling group (results-format.md); None for a run that
-    does not settle, a read before the end (settling is the end's) or a norm it
-    does not translate to.
-
-    A damped run that relaxes (method "relaxation") gives each norm read at the
-    end its own: how much it would still change. Load steps that each end in
-    equilibrium (method "newton") give the Newton correction left, delta
-    (displacement: mass-weighted RMS over the grid) and the RMS of its strain
-    over the body; a particle's displacement is a convex combination of the
-    nodes', so over the N particles its RMS, and its mean, is at most delta
-    (particle_L2, particle_L1); over k of them (a probe line's points, counted
-    as particles of the mean mass; the one of particle_Linf) at most delta
-    sqrt(N / k); an error_* column of a strain, stretch or stress (relative to
-    its exact value, a mean over a region of the body) at most
-    SETTLING_REGION_FACTOR x the strain's RMS over the strain's size, the
-    largest |F - I| entry of the particles."""
-    if case.results is None or not case.results.settling:
-        return None
-    if _output_index(np.asarray([case.end_time]), float(time), 1) is None:
-        return None
-    settling = case.results.settling
-
-    def finite(value):
-        return float(value) if isinstance(value, (int, float)) and math.isfinite(value) and value >= 0.0 else None
-
-    if settling.get("method") == "relaxation":
-        return finite(settling.get("norms", {}).get(norm))
-    delta, strain_error = finite(settling.get("displacement")), finite(settling.get("strain"))
-    particles = case.attribute("particle_count")
-    counted = isinstance(particles, (int, float)) and particles >= 1
-    if norm in ("particle_L1", "particle_L2"):
-        return delta
-    if delta is not None and counted and norm == "particle_Linf":
-        return delta * math.sqrt(particles)
-    if delta is not None and counted and norm.startswith("L1_"):
-        try:
-            line = next((l for l in read_probe_lines(case.results_path) if l.name == norm[3:]), None)
-        except (OSError, KeyError, ValueError, TypeError):
-            return None
-        # A length: the displacements' components, not an angle or a pressure.
-        if line is None or "displacement" not in line.quantity or "angular" in line.quantity \
-                or line.exact.shape[-1] == 0:
-            return None
-        return delta * math.sqrt(particles / line.exact.shape[-1])
-    if strain_error is not None and norm.startswith(RELATIVE_NORM_PREFIX) \
-            and norm.endswith(("_strain", "_stretch", "_stress")):
-        strain = _strain_size(case)
-        return None if strain is None else SETTLING_REGION_FACTOR * strain_error / strain
-    return None
-
-
-def read_point_history(path):
-    """The first probe point's history (time after every step), or None."""
-    with h5py.File(path, "r") as f:
-        for name, group in f.get("probes", {}).items():
-            quantity = _plain(group.attrs.get("quantity", ""))
-            if name != "circle" and quantity in group and group[quantity].ndim == 1:
-                return PointHistory(name, quantity, np.asarray(group.attrs.get("reference_position", [])),
-                                    np.asarray(group["time"][:], float), np.asarray(group[quantity][:], float),
-                                    np.asarray(group["exact_" + quantity][:], float))
-    return None
-
-
-def read_error_spectrum(path):
-    """/probes/circle/error_spectrum with its times, or None when absent or empty."""
-    with h5py.File(path, "r") as f:
-        circle = f.get("probes/circle")
-        if circle is None or "error_spectrum" not in circle or circle["error_spectrum"].shape[0] == 0:
-            return None
-        return ErrorSpectrum(_plain(circle.attrs.get("quantity", "")),
-                             float(circle.attrs.get("reference_radius", float("nan"))),
-                             np.asarray(circle["time"][:], float), np.asarray(circle["error_spectrum"][:], float))
-
-
-@dataclass(frozen=True)
-class ContactPressure:
-    x: np.ndarray                 # n cell midpoints [m]
-    time: np.ndarray              # T output times
-    pressure: np.ndarray          # T x n simulated contact pressure [Pa]
-    exact: np.ndarray             # T x n Hertz's pressure at the load the run measured [Pa]
-    peak_pressure: np.ndarray = None  # T: Hertz's p0 at that load [Pa] (None in files written before it)
-    half_width: np.ndarray = None     # T: Hertz's a at that load [m]
-
-
-@dataclass(frozen=True)
-class SceneHistory:
-    time: np.ndarray              # S step times
-    values: dict                  # name -> S values of a scalar recorded after every step
-
-
-def read_contact_pressure(path):
-    """/probes/contact_pressure (hertz-cylinder), or None when absent or without an output."""
-    with h5py.File(path, "r") as f:
-        group = f.get("probes/contact_pressure")
-        if not isinstance(group, h5py.Group) or any(n not in group for n in ("x", "time", "pressure",
-                                                                              "exact_pressure")):
-            return None
-        x = np.asarray(group["x"][:], float)
-        time = np.asarray(group["time"][:], float)
-        if time.size == 0 or x.size == 0:
-            return None
-        shape = (time.size, x.size)
-        exact = {name: np.asarray(group[f"exact_{name}"][:], float) for name in ("peak_pressure", "half_width")
-                 if f"exact_{name}" in group and group[f"exact_{name}"].shape == (time.size,)}
-        return ContactPressure(x, time, np.asarray(group["pressure"][:], float).reshape(shape),
-                               np.asarray(group["exact_pressure"][:], float).reshape(shape),
-                               exact.get("peak_pressure"), exact.get("half_width"))
-
-
-def read_scene_history(path):
-    """/probes/history: its time and every scalar recorded with it, or None when absent or empty."""
-    with h5py.File(path, "r") as f:
-        group = f.get("probes/history")
-        if isinstance(group, h5py.Group) and "quantity" in group.attrs:
-            return None
-        read = _time_columns(group)
-        return None if read is None else SceneHistory(*read)
-
-
-def _time_columns(group):
-    """A probe group's `time` and every other dataset shaped like it, or None when
-    the group is absent, has no `time` or no time in it."""
-    if not isinstance(group, h5py.Group) or "time" not in group:
-        return None
-    time = np.asarray(group["time"][:], float)
-    if time.size == 0:
-        return None
-    columns = {name: np.asarray(group[name][:], float) for name in group
-               if name != "time" and isinstance(group[name], h5py.Dataset) and group[name].shape == time.shape}
-    return time, columns
-
-
-@dataclass(frozen=True)
-class RunMonitors:
-    initial_energy: float         # attribute initial_energy [J per unit depth; per radian in r-z]
-    time: np.ndarray              # T output times
-    columns: dict                 # dataset name -> T values, for the datasets shaped like time
-
-    def column(self, name):
-        """The dataset `name`, or NaN at every output time when the file does not have it."""
-        return self.columns.get(name, np.full(self.time.shape, np.nan))
-
-
-def read_monitors(path):
-    """/probes/monitors, or None when absent (results files written before the
-    monitors existed) or without an output time."""
-    with h5py.File(path, "r") as f:
-        group = f.get("probes/monitors")
-        read = _time_columns(group)
-        return None if read is None else RunMonitors(float(group.attrs.get("initial_energy", float("nan"))), *read)
-
-
-def relative_energy_created(monitors):
-    """abs(energy_created) over the solver's energy_scale at each output time of a
-    RunMonitors (results-format.md): NaN where the file has no energy_scale (written
-    before it) or the scale is not positive."""
-    scale = monitors.column("energy_scale")
-    scale = np.where(scale > 0, scale, np.nan)
-    return np.abs(monitors.column("energy_created")) / scale

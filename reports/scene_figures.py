@@ -6,10 +6,11 @@ import math
 import numpy as np
 
 from . import figures
+from . import health_plot
 from . import norms
 from .figure_parts import FigureEntry, saved, split_label, time_text
 from .report_rows import PARAMETER_LABELS
-from .results import (read_contact_pressure, read_error_spectrum, read_monitors, read_point_history, read_probe_lines,
+from .probes import (read_contact_pressure, read_error_spectrum, read_monitors, read_point_history, read_probe_lines,
                      read_scene_history, relative_energy_created)
 
 
@@ -284,14 +285,14 @@ def health_figure(study, all_series, directory):
         # one colour and marker per drawn case, as level_styles gives each case of a series its own
         k = len(curves)
         style = figures.Style(figures.COLOURS[k % len(figures.COLOURS)], figures.MARKERS[k % len(figures.MARKERS)])
-        curves.append(figures.HealthCurve(label, monitors.time, relative_energy_created(monitors),
+        curves.append(health_plot.HealthCurve(label, monitors.time, relative_energy_created(monitors),
                                           monitors.column("min_J"), monitors.column("max_J"),
                                           monitors.column("max_speed_over_wave_speed"),
                                           monitors.column("max_domain_distortion"), style, stop,
                                           monitors.column("cfl_step") / monitors.column("stable_step"),
                                           monitors.column("max_wave_speed_ratio"),
                                           monitors.column("max_basis_stiffening")))
-    figure = figures.run_health(curves, f"{study}: run health at the output times")
+    figure = health_plot.run_health(curves, f"{study}: run health at the output times")
     path = saved(figure, directory, study, 'health')
     caption = (f"{study}: the run's health at each output time (/probes/monitors), one line per case. From the top: "
                "the energy balance error, abs(energy_created) over energy_scale, the solver's scale of its blow-up "

@@ -19,7 +19,8 @@ import math
 from dataclasses import dataclass
 
 from .orders import pairwise_orders, roundoff_floor
-from .results import error_scale, lookup_error, settling_scale
+from .results import lookup_error
+from .scales import error_scale, settling_scale
 
 DEFAULT_REFINE_KEY = "cells"
 
@@ -181,7 +182,7 @@ class RoundOff:
     """A usable level's error beside the exact signal it measures at the read time,
     the largest error rounding alone can leave there (reports/orders.py) and,
     for a run that settles to a static state, the largest its distance from
-    that state at the end can leave (results.settling_scale; None otherwise)."""
+    that state at the end can leave (scales.settling_scale; None otherwise)."""
     level: Level
     signal: float         # S, in the norm's unit (1 for an error relative to its exact value; NaN: not known)
     floor: float          # orders.roundoff_floor(the case's steps, M)
@@ -223,8 +224,8 @@ class RoundOff:
 def roundoff_checks(levels, norm, time=None):
     """One RoundOff per usable level of `levels`, in order, at output time `time`
     (default: the case's end time); None for a level whose exact signal or
-    coordinate size is not known (results.error_scale) and that does not settle
-    (results.settling_scale)."""
+    coordinate size is not known (scales.error_scale) and that does not settle
+    (scales.settling_scale)."""
     checks = []
     for level in usable(levels):
         case = level.case

@@ -17,7 +17,8 @@ from . import report_rows
 from . import report_tables
 from .conftest import (RING_TIMES, ROUNDOFF_SUITE, SYNTHETIC_SUITE, roundoff_cases, synthetic_ring_cases,
                       write_suite_directory)
-from .results import error_scale, read_suite, settling_scale
+from .results import read_suite
+from .scales import error_scale, settling_scale
 from .series import Level, RoundOff, error_floor_kind, refinement_series, series_levels
 
 

@@ -12,11 +12,12 @@ import h5py
 import numpy as np
 import pytest
 
-from . import figures
+from . import health_plot
 from . import report
 from . import scene_figures
 from .conftest import record_calls, write_case_results
-from .results import Case, CaseResults, RunMonitors, relative_energy_created
+from .probes import RunMonitors, relative_energy_created
+from .results import Case, CaseResults
 
 GOLD = Path(__file__).parent / "gold"
 INITIAL_ENERGY = 100.0
@@ -74,8 +75,8 @@ def gold_with_results(directory, monitors_in=()):
 
 @pytest.fixture
 def drawn(monkeypatch):
-    """The curves handed to figures.run_health, by figure title."""
-    return record_calls(monkeypatch, figures, "run_health")
+    """The curves handed to health_plot.run_health, by figure title."""
+    return record_calls(monkeypatch, health_plot, "run_health")
 
 
 needs_gold = pytest.mark.skipif(not (GOLD / "manifest.json").is_file(), reason="reports/gold is not there")
@@ -182,9 +183,9 @@ def test_measured_stable_step_adds_the_step_ratio(tmp_path, drawn):
     assert ring and all(np.allclose(c.step_ratio, 0.004 * 100.0 * (1.0 + c.time) / 2.0) for c in ring)
     assert all(np.isnan(c.step_ratio).all() for c in drawn["rz-cylinder: run health at the output times"])
     assert "the step the CFL rule takes over the measured stable step" in written["markdown"].read_text()
-    figure = figures.run_health(ring, "five panels")
+    figure = health_plot.run_health(ring, "five panels")
     assert len(figure.axes) == 5
-    four = figures.run_health(drawn["rz-cylinder: run health at the output times"], "four panels")
+    four = health_plot.run_health(drawn["rz-cylinder: run health at the output times"], "four panels")
     assert len(four.axes) == 4
 
 
@@ -208,8 +209,8 @@ def test_what_slows_the_step_gets_its_panel(tmp_path, drawn):
     cylinder = drawn["rz-cylinder: run health at the output times"]
     assert all(np.isnan(c.wave_ratio).all() and np.isnan(c.basis_stiffening).all() for c in cylinder)
     assert "the particle's state and density, max c_p / c0 (solid), and the basis, max k_p" in written["markdown"].read_text()
-    assert len(figures.run_health(ring, "with what slows the step").axes) == 5
-    assert len(figures.run_health(cylinder, "without").axes) == 4
+    assert len(health_plot.run_health(ring, "with what slows the step").axes) == 5
+    assert len(health_plot.run_health(cylinder, "without").axes) == 4
 
 
 @needs_gold

@@ -7,7 +7,8 @@ import numpy as np
 
 from . import norms
 from .conftest import write_case_results
-from .results import read_case_results, read_probe_lines
+from .probes import read_probe_lines
+from .results import read_case_results
 
 
 def test_eq_3_1_is_the_mean_absolute_difference_at_each_time():

@@ -19,7 +19,8 @@ from . import report_tables
 from .conftest import (HERTZ_END_TIME, HERTZ_SUITE, ROUNDOFF_SUITE, SYNTHETIC_SUITE, hertz_cases, hertz_exact_pressure,
                       hertz_half_width, hertz_load, record_calls, roundoff_cases, synthetic_ring_cases,
                       write_suite_directory)
-from .results import PointHistory, read_suite
+from .probes import PointHistory
+from .results import read_suite
 
 GOLD = Path(__file__).parent / "gold"
 

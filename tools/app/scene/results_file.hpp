@@ -2,7 +2,7 @@
 // attributes of its root, then /particles, /errors, /probes (lines, points,
 // the circle, histories, the scene's own, the monitors), /settling and
 // /measurements. The whole layout is written here; reports/results-format.md
-// documents it for the readers (reports/results.py).
+// documents it for the readers (reports/results.py, probes.py).
 #pragma once
 
 #include <string>

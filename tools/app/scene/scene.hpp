@@ -82,7 +82,7 @@ class SceneCase {
   // What the exact solution gives the error column `norm` to measure at output
   // time `time`, as a fraction of its largest over the output times (the mean
   // |exact| on an L1_<line> norm's line, the RMS exact displacement for the
-  // particle norms; as reports/results.py: exact_signal_fraction reads it
+  // particle norms; as reports/scales.py: exact_signal_fraction reads it
   // from a results file). None where the scene cannot say. Known before the
   // run: the suite loader warns of a read where the motion is nearly absent.
   // A NaN time is the end time.

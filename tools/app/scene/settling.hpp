@@ -2,7 +2,7 @@
 // held: scenes/quasi_static.hpp) still is from it at its end, written to
 // the results file as the measurements settling_displacement and
 // settling_strain, which the report and the gate compare errors with
-// (reports/results.py: settling_scale). An error no larger than what the
+// (reports/scales.py: settling_scale). An error no larger than what the
 // solver's stopping short of the static state leaves measures the stopping
 // point, not the method.
 //
