@@ -55,23 +55,50 @@ double p_wave_modulus(const MaterialModel& m) {
 
 namespace {
 
+// What make_stepper chose for the step beside its shape and material, each
+// from SolverOptions (model.hpp).
+struct StepSettings {
+  Scheme scheme;
+  bool apic;            // velocity_transfer = apic
+  SolverFault fault;    // none, but in a fault-injection test (faults.hpp)
+  Dilatation dilatation;
+  double split_length;  // CPDI domains longer than this are split in two (split.hpp); 0: never
+  double open_cos;      // CPDI domains whose sides meet at |cos| above this are turned (domain_angle.hpp); 1: never
+  double viscosity_linear, viscosity_quadratic;  // bulk viscosity C0, C1 (add_bulk_viscosity); 0: none
+};
+
+// The cosine above which open_sheared_domains acts, from the angle in degrees below
+// which a domain is turned; 1 (never) for 0.
+inline double min_domain_angle_cosine(double degrees) {
+  return degrees > 0.0 ? std::cos(degrees * std::numbers::pi / 180.0) : 1.0;
+}
+
+StepSettings step_settings(const SolverOptions& o, double h) {
+  return {o.scheme,
+          o.velocity_transfer == VelocityTransfer::apic,
+          o.fault,
+          o.dilatation,
+          o.split_domains_beyond * h,
+          min_domain_angle_cosine(o.min_domain_angle),
+          o.bulk_viscosity_linear,
+          o.bulk_viscosity_quadratic};
+}
+
 template <class Shape, class Material>
 class ExplicitStepper final : public Stepper {
  public:
-  ExplicitStepper(Model model, Scheme scheme, VelocityTransfer transfer, Material material,
-                  std::optional<Material> second_material, SceneStages stages, SolverFault fault,
-                  Dilatation dilatation, double split_length, double open_cos, double viscosity_linear,
-                  double viscosity_quadratic)
+  ExplicitStepper(Model model, const StepSettings& settings, Material material, std::optional<Material> second_material,
+                  SceneStages stages)
       : Stepper(std::move(model)),
-        scheme_(scheme),
-        apic_(transfer == VelocityTransfer::apic),
-        fault_(fault),
-        gradient_scale_(fault == SolverFault::cpdi_gradient ? kFaultyCpdiGradientScale : 1.0),
-        dilatation_(dilatation),
-        split_length_(split_length),
-        open_cos_(open_cos),
-        viscosity_linear_(viscosity_linear),
-        viscosity_quadratic_(viscosity_quadratic),
+        scheme_(settings.scheme),
+        apic_(settings.apic),
+        fault_(settings.fault),
+        gradient_scale_(settings.fault == SolverFault::cpdi_gradient ? kFaultyCpdiGradientScale : 1.0),
+        dilatation_(settings.dilatation),
+        split_length_(settings.split_length),
+        open_cos_(settings.open_cos),
+        viscosity_linear_(settings.viscosity_linear),
+        viscosity_quadratic_(settings.viscosity_quadratic),
         material_(material),
         second_material_(std::move(second_material)),
         second_material_from_(stages.second_material_from),
@@ -251,6 +278,9 @@ class ExplicitStepper final : public Stepper {
   }
 
  private:
+  // The three schemes side by side (002_c3305cb8b1bc1490.txt section 1.5),
+  // each the stages of one step in their order; the stages are below them.
+  //
   // Update stress last (002_c3305cb8b1bc1490.txt section 1.5): forces from the
   // stress at t_n, then velocity, position, F and finally stress.
   void step_usl(double t, double dt, double kick) {
@@ -269,55 +299,6 @@ class ExplicitStepper final : public Stepper {
     else
       velocities_from_grid<kVelocity | kPosition | kDeformation>(shape, fields_, dt, kick);
     move_domain_corners(dt);
-    update_stress_of_particles(dt);
-    book_body_work(dt);
-  }
-
-  // Corner domains move with the velocity the particles just moved with, after
-  // the last transfer that weighs the step's domains; into `to` when those are
-  // still needed (MUSL), else in place.
-  void move_domain_corners(double dt, std::vector<Vec2>* to = nullptr) {
-    if constexpr (kCornerDomains) {
-      const StageClock clock(stage_times_.update);
-      std::vector<Vec2>& corners = model_.particles.domain_corner;
-      move_corners(model_.grid, fields_, corners, to ? *to : corners, dt);
-    }
-  }
-
-  // USL for two bodies in contact (contact.hpp): each body maps to its own
-  // grid field, the fields advance apart, the contact corrects them where both
-  // bodies reach a node, and each body reads back its own field.
-  void step_usl_two_bodies(double t, double dt, double kick) {
-    Particles& P = model_.particles;
-    const Shape shape = bind(P);
-    const ParticleRange a{0, second_}, b{second_, P.size()};
-    if (body_force_) evaluate_body_force(t);
-    for (const auto& [range, field] : {std::pair{a, &fields_}, std::pair{b, &fields_b_}}) {
-      if (body_force_)
-        momentum_to_grid<kMass | kMomentum | kInternalForce | kBodyForce>(shape, *field, range);
-      else
-        momentum_to_grid<kMass | kMomentum | kInternalForce>(shape, *field, range);
-    }
-    mass_gradient_to_grid(shape, P, a.first, a.last, gradient_buffers_, gradient_a_);
-    mass_gradient_to_grid(shape, P, b.first, P.size(), gradient_buffers_, gradient_b_);
-    std::vector<double> reactions(constraints_.size(), 0.0);
-    for (GridFields* field : {&fields_, &fields_b_}) {
-      update_grid_motion(*field, kick);
-      if (damping_ > 0.0) damp_grid_motion(*field, damping_, kick);
-      walls(*field);
-      if (!constraints_.empty()) {
-        const std::vector<double> r = apply_constraints(constraints_, t, dt, kick, *field);
-        for (std::size_t k = 0; k < r.size(); ++k) reactions[k] += r[k];
-      }
-      if (damping_ > 0.0) ledger_.damping += dt * damping_power(model_.grid, *field, damping_, fixed_components_);
-    }
-    reactions_ = reactions;
-    if (!constraints_.empty()) book_constraint_work(t, dt);
-    apply_body_contact(fields_, fields_b_, gradient_a_, gradient_b_, kick, contact_forces_);
-    move_tracers(dt);
-    remember_volumes();
-    velocities_from_grid<kVelocity | kPosition | kDeformation>(shape, fields_, dt, kick, nullptr, a);
-    velocities_from_grid<kVelocity | kPosition | kDeformation>(shape, fields_b_, dt, kick, nullptr, b);
     update_stress_of_particles(dt);
     book_body_work(dt);
   }
@@ -383,6 +364,55 @@ class ExplicitStepper final : public Stepper {
     }
     P.position.swap(next_position_);
     if constexpr (kCornerDomains) P.domain_corner.swap(next_corner_);
+    update_stress_of_particles(dt);
+    book_body_work(dt);
+  }
+
+  // Corner domains move with the velocity the particles just moved with, after
+  // the last transfer that weighs the step's domains; into `to` when those are
+  // still needed (MUSL), else in place.
+  void move_domain_corners(double dt, std::vector<Vec2>* to = nullptr) {
+    if constexpr (kCornerDomains) {
+      const StageClock clock(stage_times_.update);
+      std::vector<Vec2>& corners = model_.particles.domain_corner;
+      move_corners(model_.grid, fields_, corners, to ? *to : corners, dt);
+    }
+  }
+
+  // USL for two bodies in contact (contact.hpp): each body maps to its own
+  // grid field, the fields advance apart, the contact corrects them where both
+  // bodies reach a node, and each body reads back its own field.
+  void step_usl_two_bodies(double t, double dt, double kick) {
+    Particles& P = model_.particles;
+    const Shape shape = bind(P);
+    const ParticleRange a{0, second_}, b{second_, P.size()};
+    if (body_force_) evaluate_body_force(t);
+    for (const auto& [range, field] : {std::pair{a, &fields_}, std::pair{b, &fields_b_}}) {
+      if (body_force_)
+        momentum_to_grid<kMass | kMomentum | kInternalForce | kBodyForce>(shape, *field, range);
+      else
+        momentum_to_grid<kMass | kMomentum | kInternalForce>(shape, *field, range);
+    }
+    mass_gradient_to_grid(shape, P, a.first, a.last, gradient_buffers_, gradient_a_);
+    mass_gradient_to_grid(shape, P, b.first, P.size(), gradient_buffers_, gradient_b_);
+    std::vector<double> reactions(constraints_.size(), 0.0);
+    for (GridFields* field : {&fields_, &fields_b_}) {
+      update_grid_motion(*field, kick);
+      if (damping_ > 0.0) damp_grid_motion(*field, damping_, kick);
+      walls(*field);
+      if (!constraints_.empty()) {
+        const std::vector<double> r = apply_constraints(constraints_, t, dt, kick, *field);
+        for (std::size_t k = 0; k < r.size(); ++k) reactions[k] += r[k];
+      }
+      if (damping_ > 0.0) ledger_.damping += dt * damping_power(model_.grid, *field, damping_, fixed_components_);
+    }
+    reactions_ = reactions;
+    if (!constraints_.empty()) book_constraint_work(t, dt);
+    apply_body_contact(fields_, fields_b_, gradient_a_, gradient_b_, kick, contact_forces_);
+    move_tracers(dt);
+    remember_volumes();
+    velocities_from_grid<kVelocity | kPosition | kDeformation>(shape, fields_, dt, kick, nullptr, a);
+    velocities_from_grid<kVelocity | kPosition | kDeformation>(shape, fields_b_, dt, kick, nullptr, b);
     update_stress_of_particles(dt);
     book_body_work(dt);
   }
@@ -658,12 +688,6 @@ class ExplicitStepper final : public Stepper {
   mutable double first_signal_speed_ = 0.0;
 };
 
-// The cosine above which open_sheared_domains acts, from the angle in degrees below
-// which a domain is turned; 1 (never) for 0.
-inline double min_domain_angle_cosine(double degrees) {
-  return degrees > 0.0 ? std::cos(degrees * std::numbers::pi / 180.0) : 1.0;
-}
-
 template <class Shape>
 std::unique_ptr<Stepper> make_for_shape(Model model, const SolverOptions& o, const MaterialModel& material,
                                         SceneStages stages) {
@@ -676,13 +700,9 @@ std::unique_ptr<Stepper> make_for_shape(Model model, const SolverOptions& o, con
           if (!same) throw std::invalid_argument("the second material must be a model of the same kind as the first");
           second = *same;
         }
-        return std::make_unique<ExplicitStepper<Shape, Material>>(std::move(model), o.scheme, o.velocity_transfer, m,
-                                                                 std::move(second),
-                                                                 std::move(stages),
-                                                                 o.fault, o.dilatation,
-                                                                 o.split_domains_beyond * model.grid.h,
-                                                                 min_domain_angle_cosine(o.min_domain_angle),
-                                                                 o.bulk_viscosity_linear, o.bulk_viscosity_quadratic);
+        const StepSettings settings = step_settings(o, model.grid.h);
+        return std::make_unique<ExplicitStepper<Shape, Material>>(std::move(model), settings, m, std::move(second),
+                                                                 std::move(stages));
       },
       material);
 }
