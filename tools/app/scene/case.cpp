@@ -169,15 +169,7 @@ class Case final : public SceneCase, private RunObserver {
   }
   std::string seeding() const override { return exact_seeding_ ? "exact" : "centre"; }
   double particle_volume() const override { return seeded_.particle_volume; }
-  double body_volume() const override {
-#ifdef MPMVV_HAVE_CGAL
-    if (setup_.body) {
-      const AreaMoments m = setup_.body->whole();
-      return setup_.geometry == Geometry::axisymmetric ? m.moment_x : m.area;
-    }
-#endif
-    return std::numeric_limits<double>::quiet_NaN();
-  }
+  double body_volume() const override { return exact_body_volume(setup_); }
   std::size_t particle_count() const override { return stepper_ ? stepper_->model().particles.size() : 0; }
   const ErrorTable& errors() const override { return errors_; }
 
@@ -226,7 +218,8 @@ class Case final : public SceneCase, private RunObserver {
     settling_.reset();
     if (setup_.settling) {
       settling_.emplace(*setup_.settling, loop_.end_time, !implicit());
-      if (settling_->observe(0.0, s.model().particles)) settling_->keep_norms(settling_norms(0.0, s));
+      if (settling_->observe(0.0, s.model().particles))
+        settling_->keep_norms(settling_norms(setup_, errors_, probes_, 0.0, s));
     }
   }
 
@@ -236,29 +229,9 @@ class Case final : public SceneCase, private RunObserver {
 
   void after_step(double t, const Stepper& s) override {
     if (setup_.exact_motion) monitor_log_.sample_motion(t, s.model().particles, *setup_.solution);
-    if (settling_ && settling_->observe(t, s.model().particles)) settling_->keep_norms(settling_norms(t, s));
+    if (settling_ && settling_->observe(t, s.model().particles))
+      settling_->keep_norms(settling_norms(setup_, errors_, probes_, t, s));
     probes_.after_step(t, s);
-  }
-
-  // The error norms a static scene reads at its end, at time t, for the
-  // settling of each (settling.hpp): the lines' L1, the particle displacement
-  // norms and the scene's own columns.
-  std::vector<std::pair<std::string, double>> settling_norms(double t, const Stepper& s) const {
-    std::vector<std::pair<std::string, double>> norms;
-    for (std::size_t k = 0; k < setup_.lines.size(); ++k)
-      norms.push_back({errors_.columns[k].first, probes_.line_l1(k, s.model().tracers, t)});
-    if (setup_.exact_motion) {
-      const DisplacementSums d = displacement_sums(s.model().particles, *setup_.solution, t);
-      norms.push_back({"particle_L1", d.l1 / d.weight});
-      norms.push_back({"particle_L2", std::sqrt(d.l2 / d.weight)});
-      norms.push_back({"particle_Linf", d.linf});
-    }
-    if (setup_.extra_errors) {
-      const std::vector<double> values = setup_.extra_errors(t, probes_.record(s));
-      for (std::size_t k = 0; k < values.size() && k < setup_.extra_error_names.size(); ++k)
-        norms.push_back({setup_.extra_error_names[k], values[k]});
-    }
-    return norms;
   }
 
   void at_output(std::size_t, double t, const Stepper& s) override {
@@ -271,20 +244,12 @@ class Case final : public SceneCase, private RunObserver {
     std::size_t column = setup_.lines.size();
     if (setup_.exact_motion) {
       const Particles& P = s.model().particles;
-      const DisplacementSums d = displacement_sums(P, *setup_.solution, t);
-      const double weight = d.weight;
-      errors_.columns[column++].second.push_back(d.l1 / weight);
-      errors_.columns[column++].second.push_back(std::sqrt(d.l2 / weight));
-      errors_.columns[column++].second.push_back(d.linf);
-      const FieldErrors f = field_errors(P, *setup_.solution, setup_.geometry, t, monitor_log_.j_ratio());
+      double spin = 0.0;
+      for (double value :
+           particle_norms(P, *setup_.solution, setup_.geometry, t, integrated_, monitor_log_.j_ratio(), spin))
+        errors_.columns[column++].second.push_back(value);
       monitor_log_.record_J_ratio(P);
-      if (setup_.geometry == Geometry::plane_strain) monitor_log_.set_exact_angular_momentum(f.spin);
-      errors_.columns[column++].second.push_back(std::sqrt(f.pressure / weight));
-      errors_.columns[column++].second.push_back(std::sqrt(f.deformation / weight));
-      errors_.columns[column++].second.push_back(std::sqrt(f.velocity / weight));
-      errors_.columns[column++].second.push_back(std::sqrt(d.exact2 / weight));
-      integrated_.add(t, d.l2, d.exact2);
-      errors_.columns[column++].second.push_back(integrated_.relative());
+      if (setup_.geometry == Geometry::plane_strain) monitor_log_.set_exact_angular_momentum(spin);
     }
     if (!setup_.extra_error_names.empty()) {
       const std::vector<double> extra = setup_.extra_errors(t, probes_.record(s));

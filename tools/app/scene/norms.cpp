@@ -80,6 +80,42 @@ FieldErrors field_errors(const Particles& P, const mms::ExactSolution& solution,
   return {pressure, deformation, velocity, spin};
 }
 
+std::vector<double> particle_norms(const Particles& P, const mms::ExactSolution& solution, Geometry geometry, double t,
+                                   TimeIntegral& integrated, std::vector<double>& j_ratio, double& spin) {
+  const DisplacementSums d = displacement_sums(P, solution, t);
+  const double weight = d.weight;
+  const FieldErrors f = field_errors(P, solution, geometry, t, j_ratio);
+  spin = f.spin;
+  integrated.add(t, d.l2, d.exact2);
+  return {d.l1 / weight,
+          std::sqrt(d.l2 / weight),
+          d.linf,
+          std::sqrt(f.pressure / weight),
+          std::sqrt(f.deformation / weight),
+          std::sqrt(f.velocity / weight),
+          std::sqrt(d.exact2 / weight),
+          integrated.relative()};
+}
+
+std::vector<std::pair<std::string, double>> settling_norms(const SceneSetup& setup, const ErrorTable& errors,
+                                                           const ProbeRecorder& probes, double t, const Stepper& s) {
+  std::vector<std::pair<std::string, double>> norms;
+  for (std::size_t k = 0; k < setup.lines.size(); ++k)
+    norms.push_back({errors.columns[k].first, probes.line_l1(k, s.model().tracers, t)});
+  if (setup.exact_motion) {
+    const DisplacementSums d = displacement_sums(s.model().particles, *setup.solution, t);
+    norms.push_back({"particle_L1", d.l1 / d.weight});
+    norms.push_back({"particle_L2", std::sqrt(d.l2 / d.weight)});
+    norms.push_back({"particle_Linf", d.linf});
+  }
+  if (setup.extra_errors) {
+    const std::vector<double> values = setup.extra_errors(t, probes.record(s));
+    for (std::size_t k = 0; k < values.size() && k < setup.extra_error_names.size(); ++k)
+      norms.push_back({setup.extra_error_names[k], values[k]});
+  }
+  return norms;
+}
+
 std::optional<double> exact_signal_fraction(const SceneSetup& setup, const TimeLoopOptions& loop,
                                             const std::string& norm, double time) {
   if (!setup.solution) return std::nullopt;

@@ -7,6 +7,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "mms/exact_solution.hpp"
@@ -15,6 +16,8 @@
 #include "tools/app/scene/setup.hpp"
 
 namespace mpmvv::app {
+
+class ProbeRecorder;  // probes.hpp
 
 // The columns, in order, after each probe line's L1_<line>.
 inline constexpr const char* kParticleNorms[] = {
@@ -64,6 +67,19 @@ struct TimeIntegral {
     return exact_integral > 0.0 ? std::sqrt(error_integral / exact_integral) : std::numeric_limits<double>::quiet_NaN();
   }
 };
+
+// The values of kParticleNorms at output time t, in their order (the time
+// integral `integrated` taken to t), J_p / J_exact of each particle into
+// `j_ratio` and the exact motion's angular momentum over the particles into
+// `spin` (field_errors).
+std::vector<double> particle_norms(const Particles& P, const mms::ExactSolution& solution, Geometry geometry, double t,
+                                   TimeIntegral& integrated, std::vector<double>& j_ratio, double& spin);
+
+// The error norms a static scene reads at its end, at time t, for the
+// settling of each (settling.hpp): the lines' L1, the particle displacement
+// norms and the scene's own columns.
+std::vector<std::pair<std::string, double>> settling_norms(const SceneSetup& setup, const ErrorTable& errors,
+                                                           const ProbeRecorder& probes, double t, const Stepper& s);
 
 // SceneCase::exact_signal_fraction for a scene set up as `setup` with time
 // loop `loop` (scene.hpp).

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include <fmt/format.h>
@@ -143,6 +144,16 @@ Seeded seed_particles(const SceneSetup& setup, const SeedingPlan& plan, Particle
     }
   }
   return seeded;
+}
+
+double exact_body_volume(const SceneSetup& setup) {
+#ifdef MPMVV_HAVE_CGAL
+  if (setup.body) {
+    const AreaMoments m = setup.body->whole();
+    return setup.geometry == Geometry::axisymmetric ? m.moment_x : m.area;
+  }
+#endif
+  return std::numeric_limits<double>::quiet_NaN();
 }
 
 void refuse_what_cannot_fit(const SceneSetup& setup, const Config& config) {

@@ -34,6 +34,10 @@ struct Seeded {
 // its area.
 Seeded seed_particles(const SceneSetup& setup, const SeedingPlan& plan, Particles& P);
 
+// The body's exact volume (per radian in r-z), from its CGAL description; NaN
+// without one.
+double exact_body_volume(const SceneSetup& setup);
+
 // The memory the case will hold, estimated before anything is allocated: the
 // particles (at most about 400 bytes each with the stencils a step stores and
 // the copies an output makes; 168-280 measured for CPDI,
