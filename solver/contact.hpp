@@ -122,6 +122,24 @@ void apply_rigid_contact(const RigidBody& master, const Shape& shape, const Part
 
 // ---------------------------------------------------------------- two bodies
 
+// What a second deformable body adds to a step (multi-velocity MPM): particles
+// [first, n) are that body, with their own grid velocity field, and each
+// body's normal at the nodes comes from its mass gradient. first = 0: one body.
+struct SecondBody {
+  std::size_t first = 0;
+  GridFields fields;                           // the second body's grid field
+  std::vector<Vec2> gradient_a, gradient_b;    // both bodies' mass gradients, eq. 1.107
+  std::vector<std::vector<Vec2>> buffers;      // mass_gradient_to_grid's per-thread sums
+
+  SecondBody(std::size_t first_particle, std::size_t nodes, int threads) : first(first_particle) {
+    if (first == 0) return;
+    fields.resize(nodes);
+    gradient_a.assign(nodes, Vec2::Zero());
+    gradient_b.assign(nodes, Vec2::Zero());
+    buffers.resize(std::size_t(threads));
+  }
+};
+
 // The normal of a body at the nodes, eq. 1.107: n_g = sum_p m_p G_gp, with
 // G_gp the gradient of node g's function at the particles: beside the body it
 // points out of it (the node's function grows away from the particles). One

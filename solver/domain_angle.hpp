@@ -52,6 +52,13 @@
 
 namespace mpmvv {
 
+// Whether a shape's domains are turned by the stepper (its `turned_domains` trait).
+template <class Shape>
+inline constexpr bool kTurnedDomains = [] {
+  if constexpr (requires { Shape::turned_domains; }) return Shape::turned_domains;
+  return false;
+}();
+
 // Gives every particle its reference domain's half-vectors A_p = diag(l_p),
 // the form open_sheared_domains updates.
 inline void start_domain_axes(Particles& P) {

@@ -31,6 +31,13 @@
 
 namespace mpmvv {
 
+// Whether a shape's domains are corners the stepper moves (its `corner_domains` trait).
+template <class Shape>
+inline constexpr bool kCornerDomains = [] {
+  if constexpr (requires { Shape::corner_domains; }) return Shape::corner_domains;
+  return false;
+}();
+
 // The bilinear map of a quadrilateral, x = a_0 + a_1 xi + a_2 eta + a_3 xi eta:
 // its linear part at the centre as the columns [a_1 a_2], the half-vectors a
 // parallelogram domain would have (the two coincide for a parallelogram).

@@ -27,6 +27,21 @@ struct EnergyLedger {
   double total() const { return body + constraints + contact + damping; }
 };
 
+// The body force's power over the particles, sum m b . v, with v the velocity
+// they carry over the step (the ledger's body work grows by it times dt).
+inline double body_force_power(const Particles& P) {
+  const std::size_t n = P.size();
+  ThreadOrderedSums<1> work;
+#pragma omp parallel
+  {
+    double own = 0.0;
+#pragma omp for schedule(static)
+    for (std::size_t p = 0; p < n; ++p) own += P.mass[p] * P.body_force[p].dot(P.velocity[p]);
+    work.keep({own});
+  }
+  return work.total()[0];
+}
+
 struct Monitors {
   double kinetic = 0.0;        // sum m |v|^2 / 2
   // sum m (x - o) x v about the origin o of coordinates [kg m^2/s per unit

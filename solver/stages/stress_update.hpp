@@ -97,4 +97,21 @@ ViscousStep add_bulk_viscosity(const Shape& shape, Particles& P, const std::vect
   return {dissipated.total()[0], max_ratio};
 }
 
+// A run's bulk viscosity between its stages: the coefficients, the volumes
+// before a deformation update (from which the step's dilatation is taken)
+// and the damping ratio of the last step.
+struct BulkViscosity {
+  double linear = 0.0, quadratic = 0.0;  // C0, C1 (add_bulk_viscosity); 0: none
+  double ratio = 0.0;                    // xi of the last step (ViscousStep::max_ratio)
+  std::vector<double> volume_before;     // V_p before the deformation update
+  bool on() const { return linear > 0.0 || quadratic > 0.0; }
+  void remember_volumes(const Particles& P) {
+    if (on()) volume_before = P.volume;
+  }
+  // With bulk viscosity the fastest grid mode is damped at the ratio xi of the
+  // last step, and central differences are stable to dt = (2 / omega)
+  // (sqrt(1 + xi^2) - xi): the signal speed grows by sqrt(1 + xi^2) + xi.
+  double signal_speed_factor() const { return std::sqrt(1.0 + ratio * ratio) + ratio; }
+};
+
 }  // namespace mpmvv
