@@ -1,7 +1,6 @@
 #include "static_stepper.hpp"
 
-#include <Eigen/SparseCholesky>
-#include <Eigen/SparseCore>
+#include <Eigen/Core>
 
 #include <algorithm>
 #include <chrono>
@@ -12,7 +11,10 @@
 
 #include <fmt/format.h>
 
+#include "load_work.hpp"
 #include "newton_krylov.hpp"
+#include "tangent.hpp"
+#include "unknowns.hpp"
 #include "solver/explicit_stepper.hpp"
 #include "solver/shape/cpdi.hpp"
 #include "solver/shape/cpdi_exact.hpp"
@@ -25,24 +27,11 @@ namespace mpmvv {
 
 namespace {
 
-// How a node's displacement depends on the unknowns: u = base + sum_k q[dof_k] direction_k.
-struct NodeMap {
-  int dof[2] = {-1, -1};
-  Vec2 direction[2] = {Vec2::Zero(), Vec2::Zero()};
-  Vec2 base = Vec2::Zero();
-};
-
 // What one more Newton iteration would still move (StaticStepper::remaining_correction).
 struct Remaining {
   double displacement = std::numeric_limits<double>::quiet_NaN();  // mass-weighted RMS of K^-1 R [m]
   double energy = std::numeric_limits<double>::quiet_NaN();        // R^T K^-1 R, the energy norm squared
 };
-
-// Couplings a particle makes between nodes at most this many cells apart
-// enter the preconditioner (farther ones, from domains stretched past two
-// cells, are left out of it: it stays a preconditioner).
-constexpr int kReach = 2;
-constexpr int kSpan = 2 * kReach + 1;
 
 template <class Shape, class Material>
 class StaticStepper final : public Stepper {
@@ -88,8 +77,9 @@ class StaticStepper final : public Stepper {
     NewtonKrylovResult result;
     u_.assign(nodes, Vec2::Zero());
     for (int pass = 0;; ++pass) {
-      build_map(t, dt, master_step);
-      warm_start(q);
+      const ContactUnknowns in_contact{contact_ ? &*contact_ : nullptr, active_, gap_, master_step};
+      unknowns_.build(model_.grid, fields_.mass, constraints_, in_contact, t, dt);
+      unknowns_.closest(u_, q);
       result = solve(shape, q);
       if (!result.converged) break;
       if (!contact_ || !update_active_set(shape, q, master_step)) break;
@@ -128,7 +118,7 @@ class StaticStepper final : public Stepper {
             {"newton_iterations", double(newton_iterations_)},
             {"gmres_iterations", double(linear_iterations_)},
             {"residual_evaluations", double(residual_evaluations_)},
-            {"preconditioner_seconds", preconditioner_seconds_}};
+            {"preconditioner_seconds", tangent_.seconds()}};
   }
 
   ParticleScan scan() const override {
@@ -150,101 +140,6 @@ class StaticStepper final : public Stepper {
   }
 
  private:
-  // ------------------------------------------------------------ unknowns
-
-  int wall_x(int k) const { return k == 0 ? model_.grid.ghost_layers : model_.grid.nodes_x() - 1 - model_.grid.ghost_layers; }
-  int wall_y(int k) const { return k == 0 ? model_.grid.ghost_layers : model_.grid.nodes_y() - 1 - model_.grid.ghost_layers; }
-
-  // Free components of the nodes that carry mass, between the walls; the
-  // walls' normal components, the constrained components and (for nodes in
-  // contact) the normal component are fixed; ghost nodes mirror the nodes
-  // inside.
-  void build_map(double t, double dt, const Vec2& master_step) {
-    const GridGeometry& grid = model_.grid;
-    const int nx = grid.nodes_x(), ny = grid.nodes_y();
-    map_.assign(grid.node_count(), NodeMap{});
-    std::vector<unsigned char> fixed(2 * grid.node_count(), 0);
-    std::vector<double> value(2 * grid.node_count(), 0.0);
-    for (int j = 0; j < ny; ++j)
-      for (int w = 0; w < 2; ++w) fixed[2 * std::size_t(grid.node(wall_x(w), j))] = 1;
-    for (int i = 0; i < nx; ++i)
-      for (int w = 0; w < 2; ++w) fixed[2 * std::size_t(grid.node(i, wall_y(w))) + 1] = 1;
-    for (const NodeConstraint& c : constraints_) {
-      const double increment = c.displacement(t + dt) - c.displacement(t);
-      for (std::size_t node : c.nodes) {
-        fixed[2 * node + std::size_t(c.axis)] = 1;
-        value[2 * node + std::size_t(c.axis)] = increment;
-      }
-    }
-    dofs_ = 0;
-    for (int j = wall_y(0); j <= wall_y(1); ++j)
-      for (int i = wall_x(0); i <= wall_x(1); ++i) {
-        const std::size_t node = std::size_t(grid.node(i, j));
-        if (!(fields_.mass[node] > 0.0)) continue;
-        NodeMap& m = map_[node];
-        for (int a = 0; a < 2; ++a) m.base[a] = value[2 * node + std::size_t(a)];
-        if (contact_ && active_[node]) {
-          // u.n = dU.n - gap: the normal part fixed, the rest free.
-          const Vec2 n = contact_->normal(grid.node_position(i, j), t);
-          const double c = master_step.dot(n) - gap_[node];
-          const bool fx = fixed[2 * node], fy = fixed[2 * node + 1];
-          if (!fx && !fy) {
-            m.base = c * n;
-            m.dof[0] = dofs_++;
-            m.direction[0] = Vec2(-n.y(), n.x());
-          } else if (fx && !fy && std::abs(n.y()) > 1e-12) {
-            m.base.y() = (c - m.base.x() * n.x()) / n.y();
-          } else if (fy && !fx && std::abs(n.x()) > 1e-12) {
-            m.base.x() = (c - m.base.y() * n.y()) / n.x();
-          }
-          continue;
-        }
-        int k = 0;
-        for (int a = 0; a < 2; ++a)
-          if (!fixed[2 * node + std::size_t(a)]) {
-            m.dof[k] = dofs_++;
-            m.direction[k] = a == 0 ? Vec2(1.0, 0.0) : Vec2(0.0, 1.0);
-            ++k;
-          }
-      }
-    // Ghost nodes: the mirror image across the walls they lie beyond.
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i) {
-        int mi = i, mj = j;
-        Vec2 sign(1.0, 1.0);
-        if (i < wall_x(0)) mi = 2 * wall_x(0) - i, sign.x() = -1.0;
-        if (i > wall_x(1)) mi = 2 * wall_x(1) - i, sign.x() = -1.0;
-        if (j < wall_y(0)) mj = 2 * wall_y(0) - j, sign.y() = -1.0;
-        if (j > wall_y(1)) mj = 2 * wall_y(1) - j, sign.y() = -1.0;
-        if (mi == i && mj == j) continue;
-        if (mi < 0 || mi >= nx || mj < 0 || mj >= ny) continue;
-        NodeMap m = map_[std::size_t(grid.node(mi, mj))];
-        m.base = m.base.cwiseProduct(sign);
-        for (int k = 0; k < 2; ++k) m.direction[k] = m.direction[k].cwiseProduct(sign);
-        map_[std::size_t(grid.node(i, j))] = m;
-      }
-  }
-
-  // The unknowns that come closest to the last displacements (zero at a
-  // step's start; a contact pass starts from the pass before it).
-  void warm_start(std::vector<double>& q) const {
-    q.assign(std::size_t(dofs_), 0.0);
-    for (std::size_t i = 0; i < map_.size(); ++i)
-      for (int k = 0; k < 2; ++k)
-        if (map_[i].dof[k] >= 0) q[std::size_t(map_[i].dof[k])] = (u_[i] - map_[i].base).dot(map_[i].direction[k]);
-  }
-
-  void displacements(const std::vector<double>& q, std::vector<Vec2>& u) const {
-    u.resize(map_.size());
-    for (std::size_t i = 0; i < map_.size(); ++i) {
-      const NodeMap& m = map_[i];
-      Vec2 v = m.base;
-      for (int k = 0; k < 2; ++k)
-        if (m.dof[k] >= 0) v += q[std::size_t(m.dof[k])] * m.direction[k];
-      u[i] = v;
-    }
-  }
-
   // ------------------------------------------------------------ residual
 
   // dF = I + sum_g u_g (x) G_gp over a particle's stencil.
@@ -276,78 +171,11 @@ class StaticStepper final : public Stepper {
   }
 
   bool residual(const Shape& shape, const std::vector<double>& q, std::vector<double>& r) {
-    displacements(q, u_);
+    unknowns_.displacements(q, u_);
     node_forces(shape, u_);
     std::fill(r.begin(), r.end(), 0.0);
-    for (std::size_t i = 0; i < map_.size(); ++i)
-      for (int k = 0; k < 2; ++k)
-        if (map_[i].dof[k] >= 0) r[std::size_t(map_[i].dof[k])] -= map_[i].direction[k].dot(fields_.force[i]);
+    unknowns_.subtract_forces(fields_.force, r);
     return true;
-  }
-
-  // ------------------------------------------------------------ preconditioner
-
-  // K = sum_p V_p B_p^T C B_p in the unknowns, with C the small-strain
-  // elasticity of the material: K_ab = V (lambda g_a g_b^T + mu g_b g_a^T + mu (g_a . g_b) I).
-  void assemble(const Shape& shape) {
-    const auto start = std::chrono::steady_clock::now();
-    const GridGeometry& grid = model_.grid;
-    const std::size_t nodes = grid.node_count();
-    const int nx = grid.nodes_x();
-    blocks_.assign(nodes * kSpan * kSpan, Mat2::Zero());
-    const Particles& P = model_.particles;
-    Stencil<Shape::stencil_size> s;
-    int node[Shape::stencil_size];
-    Vec2 gradient[Shape::stencil_size];
-    for (std::size_t p = 0; p < P.size(); ++p) {
-      shape.evaluate(p, s);
-      // Merge the stencil's repeated nodes (CPDI's corners share nodes),
-      // leaving out entries that carry nothing.
-      const int distinct = merged_gradients(
-          s, node, gradient, [&](int k) { return s.weight[k] == 0.0 && s.gradient[k].isZero(); });
-      const double V = P.volume[p];
-      for (int a = 0; a < distinct; ++a)
-        for (int b = 0; b < distinct; ++b) {
-          const int di = node[b] % nx - node[a] % nx, dj = node[b] / nx - node[a] / nx;
-          if (std::abs(di) > kReach || std::abs(dj) > kReach) continue;
-          const Vec2& ga = gradient[a];
-          const Vec2& gb = gradient[b];
-          const Mat2 K = V * (moduli_.lambda * ga * gb.transpose() + moduli_.mu * gb * ga.transpose() +
-                              moduli_.mu * ga.dot(gb) * Mat2::Identity());
-          blocks_[std::size_t(node[a]) * kSpan * kSpan + std::size_t((dj + kReach) * kSpan + di + kReach)] += K;
-        }
-    }
-    std::vector<Eigen::Triplet<double>> triplets;
-    double largest = 0.0;
-    for (std::size_t a = 0; a < nodes; ++a) {
-      const NodeMap& ma = map_[a];
-      if (ma.dof[0] < 0 && ma.dof[1] < 0) continue;
-      const int ia = int(a) % nx, ja = int(a) / nx;
-      for (int dj = -kReach; dj <= kReach; ++dj)
-        for (int di = -kReach; di <= kReach; ++di) {
-          const Mat2& K = blocks_[a * kSpan * kSpan + std::size_t((dj + kReach) * kSpan + di + kReach)];
-          if (K.isZero()) continue;
-          const int ib = ia + di, jb = ja + dj;
-          if (ib < 0 || jb < 0 || ib >= nx || jb >= grid.nodes_y()) continue;
-          const NodeMap& mb = map_[std::size_t(grid.node(ib, jb))];
-          for (int k = 0; k < 2; ++k)
-            for (int l = 0; l < 2; ++l)
-              if (ma.dof[k] >= 0 && mb.dof[l] >= 0) {
-                const double value = ma.direction[k].dot(K * mb.direction[l]);
-                triplets.emplace_back(ma.dof[k], mb.dof[l], value);
-                if (ma.dof[k] == mb.dof[l]) largest = std::max(largest, std::abs(value));
-              }
-        }
-    }
-    // Nodes that particles barely reach have almost no stiffness: a small
-    // diagonal keeps the factorization definite (it only preconditions).
-    for (int k = 0; k < dofs_; ++k) triplets.emplace_back(k, k, 1e-10 * largest);
-    Eigen::SparseMatrix<double> K(dofs_, dofs_);
-    K.setFromTriplets(triplets.begin(), triplets.end());
-    factor_.compute(K);
-    if (factor_.info() != Eigen::Success) throw std::runtime_error("the preconditioner's LDL^T factorization failed");
-    factored_dofs_ = dof_numbering();
-    preconditioner_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
 
   NewtonKrylovResult solve(const Shape& shape, std::vector<double>& q) {
@@ -357,7 +185,7 @@ class StaticStepper final : public Stepper {
     problem.setup = [&](const std::vector<double>&) { assemble(shape); };
     problem.solve = [&](std::vector<double>& v) {
       const Eigen::Map<Eigen::VectorXd> in(v.data(), Eigen::Index(v.size()));
-      const Eigen::VectorXd out = factor_.solve(in);
+      const Eigen::VectorXd out = tangent_.solve(in);
       std::copy(out.data(), out.data() + out.size(), v.begin());
     };
     NewtonKrylovOptions o;
@@ -368,12 +196,8 @@ class StaticStepper final : public Stepper {
     return solve_newton_krylov(problem, q, o);
   }
 
-  // Each node's two unknowns (-1: none), as build_map numbered them.
-  std::vector<int> dof_numbering() const {
-    std::vector<int> dofs;
-    dofs.reserve(2 * map_.size());
-    for (const NodeMap& m : map_) dofs.insert(dofs.end(), {m.dof[0], m.dof[1]});
-    return dofs;
+  void assemble(const Shape& shape) {
+    tangent_.assemble(shape, model_.particles, model_.grid, moduli_, unknowns_);
   }
 
   // How far the solution q still is from equilibrium: the Newton correction
@@ -390,16 +214,15 @@ class StaticStepper final : public Stepper {
   Remaining remaining_correction(const Shape& shape, const std::vector<double>& q, bool tangent_set) {
     std::vector<double> r(q.size());
     residual(shape, q, r);
-    if (!tangent_set && factored_dofs_ != dof_numbering()) assemble(shape);
+    if (!tangent_set && !tangent_.serves(unknowns_)) assemble(shape);
     const Eigen::Map<const Eigen::VectorXd> R(r.data(), Eigen::Index(r.size()));
-    const Eigen::VectorXd c = factor_.solve(R);
+    const Eigen::VectorXd c = tangent_.solve(R);
+    std::vector<Vec2> correction;
+    unknowns_.displacements(c, correction, false);
     double weighted = 0.0, mass = 0.0;
-    for (std::size_t i = 0; i < map_.size(); ++i) {
+    for (std::size_t i = 0; i < correction.size(); ++i) {
       if (!(fields_.mass[i] > 0.0)) continue;
-      Vec2 v = Vec2::Zero();
-      for (int k = 0; k < 2; ++k)
-        if (map_[i].dof[k] >= 0) v += c[map_[i].dof[k]] * map_[i].direction[k];
-      weighted += fields_.mass[i] * v.squaredNorm();
+      weighted += fields_.mass[i] * correction[i].squaredNorm();
       mass += fields_.mass[i];
     }
     Remaining out;
@@ -417,8 +240,8 @@ class StaticStepper final : public Stepper {
     const GridGeometry& grid = model_.grid;
     bool changed = false;
     const double t = time_;
-    for (int j = wall_y(0); j <= wall_y(1); ++j)
-      for (int i = wall_x(0); i <= wall_x(1); ++i) {
+    for (int j = wall_node_y(grid, 0); j <= wall_node_y(grid, 1); ++j)
+      for (int i = wall_node_x(grid, 0); i <= wall_node_x(grid, 1); ++i) {
         const std::size_t node = std::size_t(grid.node(i, j));
         if (!(fields_.mass[node] > 0.0) || !std::isfinite(gap_[node])) continue;
         const Vec2 n = contact_->normal(grid.node_position(i, j), t);
@@ -446,45 +269,10 @@ class StaticStepper final : public Stepper {
   void finish(const Shape& shape, const std::vector<double>& q, double dt) {
     residual_at(shape, q);  // u_ and fields_.force at the solution
     Particles& P = model_.particles;
-    // Work of the loads over the increment, by the trapezoid rule between the
-    // loads at the step's start and end (energy ledger, monitors.hpp).
-    const std::vector<double> previous_reactions = reactions_;
-    reactions_.clear();
-    for (std::size_t k = 0; k < constraints_.size(); ++k) {
-      const NodeConstraint& c = constraints_[k];
-      double reaction = 0.0;
-      for (std::size_t node : c.nodes) reaction -= fields_.force[node][c.axis];
-      reactions_.push_back(reaction);
-      const double before = k < previous_reactions.size() ? previous_reactions[k] : 0.0;
-      ledger_.constraints += 0.5 * (before + reaction) * (c.displacement(time_ + dt) - c.displacement(time_));
-    }
-    if (body_force_) {
-      double work = 0.0;
-      Stencil<Shape::stencil_size> s;
-      for (std::size_t p = 0; p < P.size(); ++p) {
-        shape.evaluate(p, s);
-        Vec2 move = Vec2::Zero();
-        for (int k = 0; k < s.count; ++k) move += s.weight[k] * u_[std::size_t(s.node[k])];
-        const Vec2 before = previous_body_force_.empty() ? Vec2::Zero() : previous_body_force_[p];
-        work += P.mass[p] * 0.5 * (before + P.body_force[p]).dot(move);
-      }
-      ledger_.body += work;
-      previous_body_force_ = P.body_force;
-    }
-    if (contact_) {
-      const std::vector<Vec2> previous = contact_forces_.node_force;
-      contact_forces_.node_force.assign(model_.grid.node_count(), Vec2::Zero());
-      contact_forces_.total.setZero();
-      for (std::size_t i = 0; i < active_.size(); ++i)
-        if (active_[i] && fields_.mass[i] > 0.0) {
-          contact_forces_.node_force[i] = -fields_.force[i];
-          contact_forces_.total += contact_forces_.node_force[i];
-        }
-      for (std::size_t i = 0; i < contact_forces_.node_force.size(); ++i) {
-        const Vec2 before = i < previous.size() ? previous[i] : Vec2::Zero();
-        ledger_.contact += 0.5 * (before + contact_forces_.node_force[i]).dot(u_[i]);
-      }
-    }
+    // The work of the loads over the step (load_work.hpp).
+    book_constraint_work(constraints_, fields_, time_, dt, reactions_, ledger_);
+    if (body_force_) book_body_force_work(shape, P, u_, previous_body_force_, ledger_);
+    if (contact_) book_contact_work(active_, fields_, u_, contact_forces_, ledger_);
     // Tracers move with the grid's displacement, as in the explicit step
     // (mass-weighted, stages.hpp).
     if (!model_.tracers.empty()) {
@@ -522,18 +310,14 @@ class StaticStepper final : public Stepper {
   ScatterBuffers buffers_;
   std::vector<Mat2> deformation_n_;
   std::vector<Vec2> previous_body_force_;
-  std::vector<NodeMap> map_;
-  int dofs_ = 0;
-  std::vector<Vec2> u_;
-  std::vector<Mat2> blocks_;
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> factor_;
+  GridUnknowns unknowns_;
+  std::vector<Vec2> u_;  // the node displacements of the last residual's unknowns
+  SmallStrainTangent tangent_;
   std::vector<double> gap_;
   std::vector<unsigned char> active_;
   std::string failure_;
   long newton_iterations_ = 0, linear_iterations_ = 0, residual_evaluations_ = 0, solves_ = 0;
-  double preconditioner_seconds_ = 0.0;
   Remaining remaining_;
-  std::vector<int> factored_dofs_;  // dof_numbering() when factor_ was computed; empty before
 };
 
 template <class Shape>
