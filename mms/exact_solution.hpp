@@ -13,6 +13,7 @@
 #include "factored_force.hpp"
 #include "force_field.hpp"
 #include "manufactured.hpp"
+#include "residual_check.hpp"
 #include "solver/model.hpp"
 
 namespace mpmvv::mms {
@@ -90,7 +91,7 @@ class ManufacturedSolution final : public ExactSolution {
     for (std::size_t p = 0; p < n; ++p) b[p] = m_.body_force(X[p], t);
   }
   ResidualCheck check(const Vec2& X, double t, double step = kCheckStep) const override {
-    return m_.check(X, t, step);
+    return check_residual(m_, X, t, step);
   }
   std::shared_ptr<ForceField> factored_force_field(LaneBuild build = lane_build()) const override {
     if constexpr (SeparableMotion<Motion>) return std::make_shared<FactoredForceField<Motion, Material>>(m_, build);

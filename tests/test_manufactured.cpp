@@ -1,4 +1,4 @@
-// The manufactured-solution generator (mms/jet.hpp, mms/manufactured.hpp,
+// The manufactured-solution generator (mms/jet.hpp, mms/manufactured.hpp, mms/residual_check.hpp,
 // mms/exact_solution.hpp) and the four problems built on it
 // (tools/app/scenes/): forward-mode derivatives are exact, every derived
 // body force passes the independent finite-difference residual check (what
@@ -28,6 +28,7 @@
 #include "mms/expanding_ring.hpp"
 #include "mms/jet.hpp"
 #include "mms/manufactured.hpp"
+#include "mms/residual_check.hpp"
 #include "mms/ring.hpp"
 #include "mms/rz_cylinder.hpp"
 #include "tools/app/scene/setup.hpp"

@@ -72,7 +72,7 @@ class LayeredSolution final : public mms::ExactSolution {
     for (std::size_t p = 0; p < X.size(); ++p) b[p] = body_force(X[p], t);
   }
   // The motion is smooth within each layer only (the strain jumps at the
-  // interface), so the check's differences (mms/manufactured.hpp: 3 steps of
+  // interface), so the check's differences (mms/residual_check.hpp: 3 steps of
   // a thousandth of the length each way for P, of F within each) stay within one layer: a point
   // closer to the interface is checked at the nearest point that is not.
   mms::ResidualCheck check(const Vec2& X, double t, double step = mms::kCheckStep) const override {
