@@ -24,6 +24,7 @@
 #include "config.hpp"
 #include "mpmvv_commit.hpp"
 #include "fault.hpp"
+#include "installation.hpp"
 #include "scene/scene.hpp"
 #include "scene/results_file.hpp"
 #include "solver/parallel.hpp"
@@ -40,7 +41,7 @@ std::string version_string() {
 
 int run_report_tool(const std::string& module, const std::vector<std::string>& arguments, std::ostream& err) {
   const std::string python = "/usr/bin/python3";
-  const fs::path package = MPMVV_REPORTS_DIR;  // the reports package: <root>/reports
+  const fs::path package = installation().reports;  // a folder named reports
   const fs::path path = package / (module + ".py");
   if (!fs::exists(python)) {
     fmt::print(err, "mpmvv: {} is missing: run tools/install-deps (Debian's python3 with numpy, h5py, matplotlib)\n", python);

@@ -10,6 +10,7 @@
 #include "tools/app/config.hpp"
 #include "tools/app/mms_command.hpp"
 #include "tools/app/suite/suite.hpp"
+#include "tools/app/installation.hpp"
 #include "tools/app/run_case.hpp"
 
 namespace {
@@ -62,6 +63,8 @@ int main(int argc, char** argv) {
                     "passes)");
 
   app.add_subcommand("scenes", "List the scenes and the keys each accepts.");
+  app.add_subcommand("paths", "Where this mpmvv finds its reports package and the shipped suites and scene files "
+                             "(installed under its prefix's share/mpmvv, or the source tree it was built from).");
 
   mpmvv::app::SuiteRequest suite;
   CLI::App* suite_cmd = app.add_subcommand(
@@ -169,6 +172,13 @@ int main(int argc, char** argv) {
     return mpmvv::app::run_report_tool("report", args, std::cerr);
   }
   if (gate_cmd->parsed()) return mpmvv::app::run_report_tool("gate", {gate_dir}, std::cerr);
+  if (app.got_subcommand("paths")) {
+    const mpmvv::app::Installation where = mpmvv::app::installation();
+    const char* from = where.installed ? "installed" : "source tree";
+    fmt::print("reports {} ({})\nsuites  {} ({})\nscenes  {} ({})\n", where.reports.string(), from,
+               where.suites.string(), from, (where.suites / "scenes").string(), from);
+    return 0;
+  }
   if (app.got_subcommand("scenes")) {
     std::cout << mpmvv::app::describe_scenes();
     return 0;

@@ -32,13 +32,6 @@ std::string last_line(const fs::path& log) {
 
 }  // namespace
 
-std::string self_executable() {
-  std::error_code ec;
-  const fs::path p = fs::read_symlink("/proc/self/exe", ec);
-  if (ec) throw std::runtime_error("cannot find the mpmvv executable (/proc/self/exe): " + ec.message());
-  return p.string();
-}
-
 pid_t spawn_case(const std::string& exe, const SuiteCase& c, const fs::path& results, const fs::path& log, int threads,
                  bool passive_wait, double checkpoint_seconds) {
   std::vector<std::string> args = {exe, "run", c.scene_file};

@@ -9,12 +9,10 @@
 #include <string>
 
 #include "manifest.hpp"
+#include "tools/app/installation.hpp"
 #include "suite.hpp"
 
 namespace mpmvv::app::suite_file {
-
-// The path of the running mpmvv executable, which runs each case.
-std::string self_executable();
 
 // Starts `mpmvv run` for case `c` writing `results`, its output in `log`:
 // `threads` OpenMP threads, waiting passively where cases share the cores,
