@@ -37,7 +37,10 @@ expectation holds, 1 when one falls short, 2 (one line) when DIR is not a
 readable suite output directory. The [[expect]] tables are the manifest's, which
 `mpmvv suite` checked when it loaded the suite (its one check of them).
 
-Usage: /usr/bin/python3 reports/gate.py DIR
+With --junit FILE and --json FILE the same verdicts are also written for CI
+systems (reports/gate_files.py).
+
+Usage: mpmvv gate DIR [--junit FILE] [--json FILE]
 """
 import argparse
 import math
@@ -266,6 +269,8 @@ def main(argv):
     parser = _OneLineParser(prog="mpmvv gate", description=__doc__.split("\n\n")[0],
                             epilog="Exit 0: every expectation holds; 1: one fell short; 2: bad directory or suite.")
     parser.add_argument("directory", metavar="DIR", help="a suite output directory (mpmvv suite SUITE -o DIR)")
+    parser.add_argument("--junit", metavar="FILE", help="also write the verdicts as JUnit XML (reports/gate_files.py)")
+    parser.add_argument("--json", metavar="FILE", help="also write the verdicts and their numbers as JSON")
     args = parser.parse_args(argv)
     try:
         suite = read_suite(args.directory)
@@ -280,6 +285,14 @@ def main(argv):
     except SuiteDirectoryError as error:
         print(f"mpmvv gate: {error}", file=sys.stderr)
         return 2
+    from .gate_files import write_json, write_junit
+    for path, write in ((args.junit, write_junit), (args.json, write_json)):
+        if path:
+            try:
+                write(path, suite, verdicts)
+            except OSError as error:
+                print(f"mpmvv gate: cannot write {path}: {error.strerror}", file=sys.stderr)
+                return 2
     if not suite.expectations:
         print(f"{suite.name}: no [[expect]] in the suite; nothing to check")
         return 0

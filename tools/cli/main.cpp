@@ -100,6 +100,11 @@ int main(int argc, char** argv) {
       "gate", "Check every expectation of a suite against its results.\nExit status: 0 all hold, 1 some fell short "
               "(with a table), 2 bad input.");
   gate_cmd->add_option("dir", gate_dir, "suite output directory")->required();
+  std::string gate_junit, gate_json;
+  gate_cmd->add_option("--junit", gate_junit, "also write the verdicts as JUnit XML, one test case per expectation "
+                                              "and series (GitLab, Jenkins, GitHub Actions)")->type_name("FILE");
+  gate_cmd->add_option("--json", gate_json, "also write the verdicts with every number of their rows as JSON")
+      ->type_name("FILE");
 
   CLI::App* mms_cmd = app.add_subcommand("mms", "Manufactured solutions: list them, evaluate one, check its body force.");
   mms_cmd->require_subcommand(1);
@@ -171,7 +176,12 @@ int main(int argc, char** argv) {
     if (!report_out.empty()) args.insert(args.end(), {"-o", report_out});
     return mpmvv::app::run_report_tool("report", args, std::cerr);
   }
-  if (gate_cmd->parsed()) return mpmvv::app::run_report_tool("gate", {gate_dir}, std::cerr);
+  if (gate_cmd->parsed()) {
+    std::vector<std::string> args = {gate_dir};
+    if (!gate_junit.empty()) args.insert(args.end(), {"--junit", gate_junit});
+    if (!gate_json.empty()) args.insert(args.end(), {"--json", gate_json});
+    return mpmvv::app::run_report_tool("gate", args, std::cerr);
+  }
   if (app.got_subcommand("paths")) {
     const mpmvv::app::Installation where = mpmvv::app::installation();
     const char* from = where.installed ? "installed" : "source tree";
