@@ -3,9 +3,16 @@ prefix and moved to another, the binary finds its reports package and the
 shipped suites under its own prefix (`mpmvv paths`), runs a scene from the
 installed scene files, and its gate and report read a suite directory (a copy
 of reports/gold). The installed package holds no test and no gold directory.
+Programs outside the tree (tests/installed/: C, C++ through find_package,
+Fortran through iso_c_binding, and Python through `import mpmvv`) evaluate the
+ring's body force with the installed library: the same bits in every language,
+and the force `mpmvv mms eval` gives to round-off.
 
     /usr/bin/python3 tests/installed_tree.py CMAKE BUILD_DIR   (ctest runs it; exit 1 names what failed)
 """
+import json
+import math
+import os
 import shutil
 import subprocess
 import sys
@@ -24,6 +31,7 @@ def check(condition, what):
 
 def run(*args, **kw):
     return subprocess.run([str(a) for a in args], capture_output=True, text=True, **kw)
+
 
 
 with tempfile.TemporaryDirectory() as tmp:
@@ -63,6 +71,55 @@ with tempfile.TemporaryDirectory() as tmp:
     check(report.returncode == 0 and (tmp / "report" / "report.html").is_file(),
           f"mpmvv report on the gold directory: exit {report.returncode} {report.stderr[-400:]}")
 
+    # The manufactured solutions from other languages (tests/installed/).
+    here = SOURCE / "tests" / "installed"
+    library = ["-I", prefix / "include", "-L", prefix / "lib", "-lmpmvv-mms", f"-Wl,-rpath,{prefix / 'lib'}"]
+    outputs = {}
+
+    def program(language, builds, command, env=None):
+        for build in builds:
+            made = run(*build, cwd=tmp)
+            if made.returncode != 0:
+                failures.append(f"{language}: the build failed: {made.stdout[-300:]} {made.stderr[-600:]}")
+                return
+        done = run(*command, cwd=tmp, env=env)
+        check(done.returncode == 0, f"{language}: exit {done.returncode} {done.stderr[-300:]}")
+        outputs[language] = done.stdout
+
+    program("C", [["cc", "-std=c11", "-O2", here / "ring.c", *library, "-lm", "-o", tmp / "ring-c"]],
+            [tmp / "ring-c", "100000"])
+    program("C++", [[CMAKE, "-S", here, "-B", tmp / "cxx", f"-DCMAKE_PREFIX_PATH={prefix}"],
+                    [CMAKE, "--build", tmp / "cxx"]], [tmp / "cxx" / "ring", "100000"])
+    if shutil.which("gfortran"):
+        program("Fortran", [["gfortran", "-O2", here / "ring.f90", *library, "-o", tmp / "ring-f"]], [tmp / "ring-f"])
+    else:
+        print("SKIP Fortran: gfortran is not installed (tools/install-deps installs it)")
+    script = ("import numpy as np, mpmvv\n"
+              "X = np.array([[1.0, 0.0], [0.8, 0.5], [-0.3, -0.9]])\n"
+              "b = mpmvv.Solution('ring', amplitude=0.5).body_force(X, 0.25)\n"
+              "for x, f in zip(X, b): print('b', *(repr(float(v)) for v in (*x, *f)))\n")
+    program("Python", [], [sys.executable, "-c", script],
+            env=dict(os.environ, PYTHONPATH=str(prefix / "lib" / "python3" / "dist-packages")))
+    forces = {}
+    for language, text in outputs.items():
+        rows = [line.split()[1:] for line in text.splitlines() if line.startswith("b ")]
+        forces[language] = [tuple(float(v) for v in row) for row in rows]
+        check(len(rows) == 3, f"{language}: {len(rows)} points printed, not 3")
+        if language in ("C", "C++"):
+            check("status 0" in text and "points 100000" in text, f"{language}: the 10^5 points were not evaluated")
+    reference = forces.get("C")
+    for language, values in forces.items():
+        check(values == reference, f"{language} gives {values}, C {reference}: not the same bits")
+    for X, Y, bx, by in reference or []:
+        evaluated = run(mpmvv, "mms", "eval", "ring", "--at", f"{X!r},{Y!r}", "--time", "0.25", "--set",
+                        "amplitude=0.5", "--json")
+        b = json.loads(evaluated.stdout)["body_force"]
+        scale = math.hypot(*b)
+        check(math.hypot(bx - b[0], by - b[1]) <= 1e-13 * scale,
+              f"at ({X}, {Y}) the library gives ({bx}, {by}), mpmvv mms eval ({b[0]}, {b[1]})")
+
+for language, values in forces.items():
+    print(f"{language}: b at the three points {values and [v[2:] for v in values]}")
 for f in failures:
     print("FAIL", f)
 sys.exit(1 if failures else 0)

@@ -19,7 +19,7 @@ LAYERS = [
     ("solver/", "low"), ("mms/", "low"), ("analytic/", "low"),
     ("tools/app/scene/", "scene"), ("tools/app/scenes/", "scenes"), ("tools/app/suite/", "suite"),
     ("tools/app/run_case", "command"), ("tools/app/mms_command", "command"),
-    ("tools/app/", "shared"), ("tools/cli/", "cli"), ("tools/bench/", "cli"), ("tests/", "cli"),
+    ("tools/app/", "shared"), ("tools/cli/", "cli"), ("tools/bench/", "cli"), ("tools/lib/", "cli"), ("tests/", "cli"),
 ]
 FORBIDDEN = {
     "low": {"shared", "scene", "scenes", "suite", "command", "cli"},

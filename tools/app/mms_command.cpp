@@ -13,8 +13,6 @@
 
 namespace mpmvv::app {
 
-namespace {
-
 // The scene's configuration with its defaults and the overrides; throws ConfigError.
 const SceneType& scene_named(const std::string& name) {
   const SceneType* p = find_scene_type(name);
@@ -32,6 +30,21 @@ SceneSetup setup_for(const SceneType& scene, const std::vector<std::string>& ove
   return scene.setup(config);
 }
 
+std::vector<KeySpec> solution_parameters(const SceneType& scene) {
+  // The solver's keys (solver_keys: method, resolution, time, health) and
+  // the keys of how a run samples and bounds the body belong to runs, not to
+  // the solution.
+  std::vector<std::string> run_only = {"probe_points", "circle_points", "seeding", "body_force_quadrature", "domain",
+                                       "rims"};
+  for (const KeySpec& k : solver_keys(1, 1.0, {1.0})) run_only.push_back(k.name);
+  std::vector<KeySpec> keys;
+  for (const KeySpec& k : scene.keys())
+    if (std::find(run_only.begin(), run_only.end(), k.name) == run_only.end()) keys.push_back(k);
+  return keys;
+}
+
+namespace {
+
 Json json_of(const Vec2& v) { return {v.x(), v.y()}; }
 Json json_of(const Mat2& m) { return {{m(0, 0), m(0, 1)}, {m(1, 0), m(1, 1)}}; }
 
@@ -48,13 +61,8 @@ std::string mms_list() {
       continue;
     }
     s += fmt::format("{}: {}\n", p.name, p.summary);
-    for (const KeySpec& k : p.keys()) {
-      // The solver's keys belong to runs, not to the solution.
-      static const char* solver_only[] = {"method", "scheme", "time_integration", "cells", "particles_per_direction",
-                                          "cfl", "end_time", "output_times", "probe_points", "circle_points"};
-      if (std::find(std::begin(solver_only), std::end(solver_only), k.name) != std::end(solver_only)) continue;
+    for (const KeySpec& k : solution_parameters(p))
       s += fmt::format("  {:<16} default {:<14} {}\n", k.name, format_value(k.default_value), k.help);
-    }
   }
   if (!exact_only.empty())
     s += fmt::format("exact solutions without a manufactured force (mms eval and mms check take them too; "

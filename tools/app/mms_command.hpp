@@ -10,7 +10,17 @@
 #include <string>
 #include <vector>
 
+#include "config.hpp"
+#include "scene/setup.hpp"
+
 namespace mpmvv::app {
+
+// The scene of that name; throws ConfigError naming the known ones.
+const SceneType& scene_named(const std::string& name);
+// Its setup with its defaults and the overrides "key=value"; throws ConfigError.
+SceneSetup setup_for(const SceneType& scene, const std::vector<std::string>& overrides);
+// The keys that set the scene's solution (its own and its material's), not the run's.
+std::vector<KeySpec> solution_parameters(const SceneType& scene);
 
 std::string mms_list();
 
