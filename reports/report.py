@@ -7,9 +7,11 @@ Writes
   OUT/report.html   self-contained (figures embedded as base64 PNG, no external links)
   OUT/report.md     the same text, figures linked from OUT/figures/*.png
   OUT/orders.csv    one row per (study, refinement series, error norm, output time)
+  OUT/levels.csv    one row per level of each of those rows
   OUT/gci.csv       Richardson extrapolation and GCI of each series' point-probe value
 
-The columns of orders.csv are ORDERS_CSV_COLUMNS below; the report states them.
+The columns of orders.csv and levels.csv are ORDERS_CSV_COLUMNS and LEVELS_CSV_COLUMNS
+(report_rows.py); the report states them.
 
 Norms are defined in reports/norms.py, orders, the classification rule and
 the GCI in reports/orders.py, refinement series in reports/series.py.
@@ -26,9 +28,10 @@ from pathlib import Path
 from . import gate
 from . import orders
 from .report_figures import study_figures
-from .report_rows import ORDERS_CSV_COLUMNS, gci_rows, order_rows, stored_norm_check
+from .report_rows import LEVELS_CSV_COLUMNS, ORDERS_CSV_COLUMNS, gci_rows, order_rows, stored_norm_check
 from .report_tables import (case_table, expectation_table, gci_table, measurement_sections, orders_table,
-                           reference_sections, write_gci_csv, write_orders_csv)
+                           reference_sections, write_gci_csv, write_levels_csv,
+                           write_orders_csv)
 from .results import SuiteDirectoryError, read_suite
 
 
@@ -85,7 +88,9 @@ def build_report(suite, figure_directory):
     fitted = [r for r in rows if len(r.levels) >= 2]
     sections.append(("Observed orders", DEFINITIONS + f" {len(rows) - len(fitted)} of {len(rows)} (series, norm, "
                      "time) combinations have fewer than two usable levels and are left out here. orders.csv has "
-                     "every row, with the columns " + "; ".join(f"{n} ({m})" for n, m in ORDERS_CSV_COLUMNS) + ".",
+                     "every row, with the columns " + "; ".join(f"{n} ({m})" for n, m in ORDERS_CSV_COLUMNS) +
+                     "; levels.csv each row's levels, one per line, with the columns " +
+                     "; ".join(f"{n} ({m})" for n, m in LEVELS_CSV_COLUMNS[6:]) + ".",
                      orders_table(fitted)))
     sections.append(("Richardson extrapolation and grid convergence index",
                      "Roache's GCI (safety factor 1.25) of the point probe's simulated value on the three finest "
@@ -195,10 +200,11 @@ def write_report(directory, output=None):
         old.unlink()
     report = build_report(suite, figure_directory)
     written = {"html": output / "report.html", "markdown": output / "report.md",
-               "orders": output / "orders.csv", "gci": output / "gci.csv"}
+               "orders": output / "orders.csv", "levels": output / "levels.csv", "gci": output / "gci.csv"}
     written["html"].write_text(render_html(report))
     written["markdown"].write_text(render_markdown(report, output))
     write_orders_csv(report.order_rows, written["orders"])
+    write_levels_csv(report.order_rows, written["levels"])
     write_gci_csv(report.gci_rows, written["gci"])
     return written, sum(e.path is not None for e in report.figures)
 

@@ -1,6 +1,7 @@
 """The numbers of a report (report.py): orders.csv and gci.csv rows, one per
 (study, refinement series, norm, output time) and per point-probe series, and
-the stored-norm check; the columns of orders.csv are ORDERS_CSV_COLUMNS."""
+the stored-norm check; the columns of orders.csv and levels.csv are ORDERS_CSV_COLUMNS and
+LEVELS_CSV_COLUMNS."""
 import math
 from dataclasses import dataclass
 
@@ -13,6 +14,8 @@ from .series import (DEFAULT_REFINE_KEY, floor_kind, refined_size, refinement_se
                     steps_of, usable)
 
 
+# orders.csv: one row per (study, refinement series, norm, time), one value
+# per cell; the levels behind each row are levels.csv's (LEVELS_CSV_COLUMNS).
 ORDERS_CSV_COLUMNS = (
     ("study", "the study"),
     ("series", "the keys that name the refinement series"),
@@ -20,11 +23,8 @@ ORDERS_CSV_COLUMNS = (
     ("unit", "its unit"),
     ("time", "output time [s]"),
     ("refine", "the key that refines"),
-    ("levels", "its values at the usable levels, coarse first, ';'-separated"),
-    ("h", "the size the refine key sets at those levels: cell size h [m]; h / particles_per_direction [m] for "
-          "particles per direction; cfl h [m] for cfl; 1 / load_steps (reports/series.py: REFINED_SIZES)"),
-    ("error", "the norm at those levels"),
-    ("pairwise_orders", "orders between consecutive usable levels (empty at round-off)"),
+    ("levels", "how many levels are usable (levels.csv lists them)"),
+    ("left_out", "how many levels have no usable value at that time (levels.csv says why)"),
     ("ls_order", "least-squares order (NaN at round-off)"),
     ("ci_low", "lower end of its 95% Student-t interval (NaN with two levels or at round-off)"),
     ("ci_high", "upper end"),
@@ -32,15 +32,28 @@ ORDERS_CSV_COLUMNS = (
     ("finest_level", "refine value of the finest usable level"),
     ("finest_h", "its size (as h)"),
     ("finest_error", "its error"),
-    ("left_out", "levels without a usable value at that time, and why"),
-    ("relative_error", "each usable level's error over the exact signal the norm measures at that time (NaN where "
-                       "not known; error_* and particle_relative_L2_integrated are relative already: signal 1)"),
-    ("roundoff_floor", "each usable level's round-off floor, (256 + steps) ulps of the numbers the error is a "
-                       "difference of, over the same signal: a level whose relative_error is at most this is at "
-                       "round-off (reports/orders.py)"),
-    ("settling", "each usable level's settling level over the same signal, the largest error the run's distance "
-                 "from its static state at the end could leave (scales.py: settling_scale; NaN for a run that "
-                 "does not settle): a level whose relative_error is at most this is at the settling level"),
+)
+# levels.csv: one row per level of each orders.csv row, the usable ones coarse
+# first, then those left out.
+LEVELS_CSV_COLUMNS = (
+    ("study", "as orders.csv"), ("series", "as orders.csv"), ("norm", "as orders.csv"), ("unit", "as orders.csv"),
+    ("time", "as orders.csv"), ("refine", "as orders.csv"),
+    ("level", "the refine key's value"),
+    ("h", "the size the refine key sets: cell size h [m]; h / particles_per_direction [m] for particles per "
+          "direction; cfl h [m] for cfl; 1 / load_steps (reports/series.py: REFINED_SIZES)"),
+    ("error", "the norm at that level (NaN where not usable)"),
+    ("used", "1 when the level is usable and in the fit, 0 when left out"),
+    ("reason", "why a level is left out; empty when used"),
+    ("order_from_coarser", "the order between this usable level and the usable one before it (NaN for the first, "
+                           "and at round-off)"),
+    ("relative_error", "the error over the exact signal the norm measures at that time (NaN where not known; "
+                       "error_* and particle_relative_L2_integrated are relative already: signal 1)"),
+    ("roundoff_floor", "the round-off floor, (256 + steps) ulps of the numbers the error is a difference of, over "
+                       "the same signal: a level whose relative_error is at most this is at round-off "
+                       "(reports/orders.py)"),
+    ("settling", "the settling level over the same signal, the largest error the run's distance from its static "
+                 "state at the end could leave (scales.py: settling_scale; NaN for a run that does not settle): a "
+                 "level whose relative_error is at most this is at the settling level"),
 )
 METHOD_KEYS = ("method", "scheme", "particles_per_direction", "cfl", "time_integration", "solver", "load_steps",
                "dilatation", "formulation")

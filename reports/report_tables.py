@@ -9,7 +9,7 @@ import numpy as np
 from . import gate
 from . import norms
 from . import references
-from .report_rows import ORDERS_CSV_COLUMNS, line_quantities, order_row, study_series
+from .report_rows import LEVELS_CSV_COLUMNS, ORDERS_CSV_COLUMNS, line_quantities, order_row, study_series
 from .results import lookup_error
 from .series import floor_text
 
@@ -152,10 +152,6 @@ def expectation_table(verdicts):
                  ["PASS" if v.passed else "FAIL" for v in verdicts])
 
 
-def _joined(values):
-    return ";".join(repr(float(v)) for v in values)
-
-
 def _per_level(row, value):
     """value(check) for each usable level of the row, NaN where its exact signal is not known
     (and for a row of fewer than two levels, which is not checked)."""
@@ -171,16 +167,31 @@ def write_orders_csv(rows, path):
         for r in rows:
             finest = r.levels[-1] if r.levels else None
             writer.writerow([r.study, r.series.label, r.norm, r.unit, repr(r.time), r.series.refine,
-                             ";".join(str(l.value) for l in r.levels), _joined(l.h for l in r.levels),
-                             _joined(l.error for l in r.levels), _joined(r.pairwise) if r.has_order else "",
+                             len(r.levels), len(r.left_out),
                              *(repr(v if r.has_order else float("nan")) for v in (r.fit.order, r.fit.ci_low,
                                                                                    r.fit.ci_high)),
                              r.classification, finest.value if finest else "", repr(finest.h) if finest else "",
-                             repr(finest.error) if finest else "",
-                             ";".join(f"{l.value}: {l.reason}" for l in r.left_out),
-                             _joined(_per_level(r, lambda c: c.relative_error)),
-                             _joined(_per_level(r, lambda c: c.relative_floor)),
-                             _joined(_per_level(r, lambda c: c.relative_settling))])
+                             repr(finest.error) if finest else ""])
+
+
+def write_levels_csv(rows, path):
+    nan = float("nan")
+    with open(path, "w", newline="") as stream:
+        writer = csv.writer(stream)
+        writer.writerow([name for name, _ in LEVELS_CSV_COLUMNS])
+        for r in rows:
+            row = [r.study, r.series.label, r.norm, r.unit, repr(r.time), r.series.refine]
+            pairwise = [nan] + list(r.pairwise) if r.has_order else [nan] * len(r.levels)
+            relative = _per_level(r, lambda c: c.relative_error)
+            floor = _per_level(r, lambda c: c.relative_floor)
+            settling = _per_level(r, lambda c: c.relative_settling)
+            for k, level in enumerate(r.levels):
+                writer.writerow(row + [level.value, repr(float(level.h)), repr(float(level.error)), 1, "",
+                                       repr(float(pairwise[k])), repr(float(relative[k])), repr(float(floor[k])),
+                                       repr(float(settling[k]))])
+            for level in r.left_out:
+                writer.writerow(row + [level.value, repr(float(level.h)), repr(nan), 0, level.reason,
+                                       *[repr(nan)] * 4])
 
 
 def write_gci_csv(rows, path):

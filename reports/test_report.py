@@ -64,18 +64,31 @@ def test_report_html_is_self_contained(synthetic_report):
 
 def test_orders_csv_holds_the_exact_order_of_the_synthetic_series(synthetic_report):
     """Requirement: orders.csv has one row per (study, series, norm, time) with the
-    pairwise and least-squares orders; the cpdi series (0.5 h^2) gives 2.000."""
+    least-squares order, one value per cell; levels.csv one row per level of each
+    with its h, error and the pairwise order from the coarser level; the cpdi
+    series (0.5 h^2) gives 2.000."""
     with open(synthetic_report[1]["orders"]) as stream:
         rows = list(csv.DictReader(stream))
+    with open(synthetic_report[1]["levels"]) as stream:
+        levels = list(csv.DictReader(stream))
     keys = {(r["study"], r["series"], r["norm"], r["time"]) for r in rows}
     assert len(keys) == len(rows) == 2 * 3                     # 2 series x 3 norms at the end time
+    assert not any(";" in value for r in rows + levels for name, value in r.items() if name != "reason")
     cpdi = next(r for r in rows if r["series"] == "method=cpdi" and r["norm"] == "L1_theta0")
     assert abs(float(cpdi["ls_order"]) - 2.0) < 1e-12
-    assert [abs(float(p) - 2.0) < 1e-12 for p in cpdi["pairwise_orders"].split(";")] == [True, True]
-    assert cpdi["levels"] == "32;64;128" and cpdi["classification"] == "asymptotic"
-    assert "256: pending" in cpdi["left_out"]
-    linear = next(r for r in rows if r["series"] == "method=linear" and r["norm"] == "L1_theta0")
-    assert linear["levels"] == "32;256" and "64: no output at t = 1" in linear["left_out"]
+    assert (cpdi["levels"], cpdi["left_out"], cpdi["classification"]) == ("3", "1", "asymptotic")
+
+    def of(series):
+        return [l for l in levels if l["series"] == series and l["norm"] == "L1_theta0"]
+    cpdi_levels = of("method=cpdi")
+    assert [(l["level"], l["used"]) for l in cpdi_levels] == [("32", "1"), ("64", "1"), ("128", "1"), ("256", "0")]
+    assert cpdi_levels[0]["order_from_coarser"] == "nan"
+    assert [abs(float(l["order_from_coarser"]) - 2.0) < 1e-12 for l in cpdi_levels[1:3]] == [True, True]
+    assert [float(l["error"]) for l in cpdi_levels[:3]] == pytest.approx([0.5 * (3.0 / n) ** 2 for n in (32, 64, 128)])
+    assert cpdi_levels[3]["reason"] == "pending" and cpdi_levels[3]["error"] == "nan"
+    linear = of("method=linear")
+    assert [l["level"] for l in linear if l["used"] == "1"] == ["32", "256"]
+    assert any(l["level"] == "64" and l["reason"].startswith("no output at t = 1") for l in linear)
 
 
 def test_report_survives_a_damaged_results_file_and_a_missing_suite_file(tmp_path):
@@ -338,12 +351,18 @@ def test_report_gives_no_order_for_errors_at_round_off(tmp_path, monkeypatch):
     written = render(directory, tmp_path / "out")[0]
     with open(written["orders"]) as stream:
         rows = {(r["study"], r["norm"]): r for r in csv.DictReader(stream)}
+    with open(written["levels"]) as stream:
+        levels = list(csv.DictReader(stream))
+
+    def levels_of(key):
+        return [l for l in levels if (l["study"], l["norm"]) == key and l["used"] == "1"]
     for key in (("roundoff", "L1_theta0"), ("roundoff", "particle_L2")):
         assert rows[key]["classification"] == "round-off"
-        assert rows[key]["pairwise_orders"] == "" and rows[key]["ls_order"] == "nan"
-    line = rows[("roundoff", "L1_theta0")]
-    relative = [float(v) for v in line["relative_error"].split(";")]
-    floor = [float(v) for v in line["roundoff_floor"].split(";")]
+        assert rows[key]["ls_order"] == "nan"
+        assert all(l["order_from_coarser"] == "nan" for l in levels_of(key))
+    line = levels_of(("roundoff", "L1_theta0"))
+    relative = [float(l["relative_error"]) for l in line]
+    floor = [float(l["roundoff_floor"]) for l in line]
     assert relative == pytest.approx([4e-13 / 0.573977410425004, 1e-13 / 0.573977410425004,
                                       2.5e-14 / 0.573977410425004], rel=1e-9)
     assert floor == pytest.approx([356 * 2.220446049250313e-16 * np.pi / 0.573977410425004] * 3, rel=1e-9)

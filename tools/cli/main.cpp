@@ -92,7 +92,7 @@ int main(int argc, char** argv) {
 
   std::string report_dir, report_out;
   CLI::App* report_cmd = app.add_subcommand(
-      "report", "Tables, figures, report.html, report.md and orders.csv from a suite's results (no solver runs).");
+      "report", "Tables, figures, report.html, report.md, orders.csv and levels.csv from a suite's results (no solver runs).");
   report_cmd->add_option("dir", report_dir, "suite output directory")->required();
   report_cmd->add_option("-o,--output", report_out, "where to write; default DIR/report")->type_name("DIR");
   std::string gate_dir;
