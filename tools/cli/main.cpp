@@ -106,6 +106,13 @@ int main(int argc, char** argv) {
   gate_cmd->add_option("--json", gate_json, "also write the verdicts with every number of their rows as JSON")
       ->type_name("FILE");
 
+  std::vector<std::string> results_files;
+  CLI::App* results_cmd = app.add_subcommand("results", "Results files: check one against the documented format.");
+  results_cmd->require_subcommand(1);
+  CLI::App* results_check_cmd = results_cmd->add_subcommand(
+      "check", "Name every missing or malformed item of results files (reports/results-format.md).\nExit status: 0 "
+               "every file follows the format, 1 some item is missing or malformed, 2 a file is not HDF5.");
+  results_check_cmd->add_option("files", results_files, "results files")->required();
   CLI::App* mms_cmd = app.add_subcommand("mms", "Manufactured solutions: list them, evaluate one, check its body force.");
   mms_cmd->require_subcommand(1);
   mms_cmd->add_subcommand("list", "The manufactured solutions and their parameters.");
@@ -176,6 +183,7 @@ int main(int argc, char** argv) {
     if (!report_out.empty()) args.insert(args.end(), {"-o", report_out});
     return mpmvv::app::run_report_tool("report", args, std::cerr);
   }
+  if (results_check_cmd->parsed()) return mpmvv::app::run_report_tool("results_check", results_files, std::cerr);
   if (gate_cmd->parsed()) {
     std::vector<std::string> args = {gate_dir};
     if (!gate_junit.empty()) args.insert(args.end(), {"--junit", gate_junit});
