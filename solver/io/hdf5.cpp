@@ -259,13 +259,20 @@ std::string Group::attribute_string(const std::string& name) const {
   return value;
 }
 
-std::vector<double> Group::read_doubles(const std::string& name, std::vector<hsize_t>* dims) const {
+std::vector<hsize_t> Group::dimensions(const std::string& name) const {
   const std::string what = join(path_, name);
   Handle set(check(H5Dopen2(id(), name.c_str(), H5P_DEFAULT), "H5Dopen2", what), H5Dclose);
   Handle space(check(H5Dget_space(set.get()), "H5Dget_space", what), H5Sclose);
   const int rank = check(H5Sget_simple_extent_ndims(space.get()), "H5Sget_simple_extent_ndims", what);
   std::vector<hsize_t> d(std::size_t(rank), 0);
   check(H5Sget_simple_extent_dims(space.get(), d.data(), nullptr), "H5Sget_simple_extent_dims", what);
+  return d;
+}
+
+std::vector<double> Group::read_doubles(const std::string& name, std::vector<hsize_t>* dims) const {
+  const std::string what = join(path_, name);
+  const std::vector<hsize_t> d = dimensions(name);
+  Handle set(check(H5Dopen2(id(), name.c_str(), H5P_DEFAULT), "H5Dopen2", what), H5Dclose);
   hsize_t count = 1;
   for (hsize_t x : d) count *= x;
   std::vector<double> data(count);

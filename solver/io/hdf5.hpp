@@ -76,6 +76,8 @@ class Group {
   std::int64_t attribute_int(const std::string& name) const;
   std::string attribute_string(const std::string& name) const;
   std::vector<double> read_doubles(const std::string& name, std::vector<hsize_t>* dims = nullptr) const;
+  // A dataset's dimensions, without reading it.
+  std::vector<hsize_t> dimensions(const std::string& name) const;
   // The length of a dataset of bytes, and its bytes into `out` (`size` of
   // them, which must be its length).
   std::size_t byte_count(const std::string& name) const;

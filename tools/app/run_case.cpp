@@ -27,6 +27,7 @@
 #include "installation.hpp"
 #include "scene/scene.hpp"
 #include "scene/results_file.hpp"
+#include "scene/xdmf_file.hpp"
 #include "solver/parallel.hpp"
 #include "solver/time_loop.hpp"
 #include "suite/suite.hpp"
@@ -290,6 +291,13 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
     fs::remove(partial, ec);
     fmt::print(err, "mpmvv run: writing {} failed: {}\n", output, e.what());
     return 2;
+  }
+  // The ParaView sidecar, from the file as written; the results stand without it.
+  try {
+    write_xdmf_sidecar(output);
+  } catch (const std::exception& e) {
+    fmt::print(err, "mpmvv run: {} is written; its ParaView sidecar {} is not: {}\n", output,
+               xdmf_sidecar_path(output), e.what());
   }
 
   const double rate = o.wall_seconds > 0 ? double(o.particle_steps) / o.wall_seconds : 0.0;

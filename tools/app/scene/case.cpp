@@ -16,6 +16,7 @@
 #include "restart_file.hpp"
 #include "results_file.hpp"
 #include "seeding.hpp"
+#include "snapshots.hpp"
 #include "solver/explicit_stepper.hpp"
 #include "setup.hpp"
 #ifdef MPMVV_HAVE_SUNDIALS
@@ -126,6 +127,7 @@ class Case final : public SceneCase, private RunObserver {
     a.field("rule_step", rule_step_);
     a.field("errors", errors_);
     a.field("integrated", integrated_);
+    snapshots_.persist(a);
     bool settling = settling_.has_value();
     a.field("settling", settling);
     if (a.reads()) {
@@ -181,7 +183,10 @@ class Case final : public SceneCase, private RunObserver {
   std::string error_description() const override { return norm_definitions(); }
 
   void write_results(h5::Group& root) const override {
-    write_particles(root, stepper_->model().particles);
+    const Particles& P = stepper_->model().particles;
+    write_particles(root, P);
+    write_particle_index(root, std::max(P.size(), snapshots_.largest_count()));
+    snapshots_.write(root);
     h5::Group probes = root.create_group("probes");
     write_probes(probes, probes_);
     if (setup_.write_extra) setup_.write_extra(probes);
@@ -238,6 +243,8 @@ class Case final : public SceneCase, private RunObserver {
     monitor_log_.record(t, s, int(config_.integer("stable_step_iterations")), rule_step_,
                         config_.real("energy_blowup_factor"));
     errors_.time.push_back(t);
+    if (config_.text("particle_fields") == "outputs")
+      snapshots_.record(t, s.model().particles, setup_.exact_motion ? setup_.solution.get() : nullptr);
     const std::vector<double> line_l1 = probes_.at_output(t, s.model().tracers);
     for (std::size_t k = 0; k < line_l1.size(); ++k) errors_.columns[k].second.push_back(line_l1[k]);
     // Volume-weighted errors over all particles (norms.hpp).
@@ -270,6 +277,7 @@ class Case final : public SceneCase, private RunObserver {
   RunOutcome outcome_;
 
   ProbeRecorder probes_;
+  ParticleSnapshots snapshots_;  // with particle_fields = "outputs"
   MonitorLog monitor_log_;
   double rule_step_ = std::numeric_limits<double>::quiet_NaN();  // the time-step rule's last step
   ErrorTable errors_;

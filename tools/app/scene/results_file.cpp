@@ -3,6 +3,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <numeric>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -165,6 +166,12 @@ void write_particles(h5::Group& root, const Particles& P) {
   if (P.domain_corner.size() == 4 * n && n > 0) {
     g.write_rows("domain_corners", {n, 4, 2}, vectors(P.domain_corner, 4));
   }
+}
+
+void write_particle_index(h5::Group& root, std::size_t count) {
+  std::vector<std::int64_t> index(count);
+  std::iota(index.begin(), index.end(), std::int64_t{0});
+  root.write("particle_index", index, {count});
 }
 
 void write_probes(h5::Group& probes, const ProbeRecorder& r) {

@@ -39,6 +39,9 @@ void write_results_file(const std::string& path, const RunIdentity& identity, co
 
 // The groups a scene writes (SceneCase::write_results).
 void write_particles(h5::Group& root, const Particles& particles);
+// /particle_index: 0 .. count - 1, the particles as cells of one vertex each
+// for the .xmf sidecar (xdmf_file.hpp); count the most particles any group holds.
+void write_particle_index(h5::Group& root, std::size_t count);
 void write_errors(h5::Group& root, const ErrorTable& errors, const std::string& description);
 void write_probes(h5::Group& probes, const ProbeRecorder& recorder);
 void write_monitors(h5::Group& probes, const MonitorLog& log, bool stable_step);

@@ -87,6 +87,11 @@ std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_
       {"output_times", KeyKind::real_list, std::move(default_output_times),
        "times at which probes and errors are recorded [s]; later than end_time are dropped, end_time is always one",
        0.0, inf, true},
+      {"particle_fields", KeyKind::text, std::string("end"),
+       "end: the particles' state at the end only (/particles); outputs: also their position, displacement, "
+       "velocity, J, stress, F and displacement error at every output time (/snapshots, about 120 bytes a particle "
+       "and output), which ParaView animates through the results file's .xmf sidecar",
+       -inf, inf, false, false, {"end", "outputs"}},
       {"stable_step_iterations", KeyKind::integer, std::int64_t(0),
        "power iterations that measure, at every output time, the largest frequency omega_max of the grid's motion "
        "linearized about the run's state, and so its stable step 2 / omega_max, beside the step the CFL rule takes "

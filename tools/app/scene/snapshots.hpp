@@ -1,0 +1,35 @@
+// The particles' fields at every output time, when a run asks for them
+// (particle_fields = "outputs"): position, displacement, velocity, J, the
+// Cauchy stress, F and, with an exact motion, the displacement error. The
+// results file holds them under /snapshots, and its .xmf sidecar
+// (xdmf_file.hpp) lets ParaView animate them. Each output keeps its own
+// particle count (a split adds particles).
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "mms/exact_solution.hpp"
+#include "solver/io/hdf5.hpp"
+#include "solver/io/state_archive.hpp"
+#include "solver/particles.hpp"
+
+namespace mpmvv::app {
+
+class ParticleSnapshots {
+ public:
+  // `exact`: the exact motion, or null for a scene without one (no error field).
+  void record(double t, const Particles& P, const mms::ExactSolution* exact);
+  bool empty() const { return time_.empty(); }
+  // The most particles any output held.
+  std::size_t largest_count() const;
+  // /snapshots/<k> for the k-th output: attribute `time`, and the fields.
+  void write(h5::Group& root) const;
+  void persist(StateArchive& a);
+
+ private:
+  std::vector<double> time_;
+  std::vector<std::vector<double>> position_, displacement_, velocity_, J_, stress_, F_, error_;
+};
+
+}  // namespace mpmvv::app
