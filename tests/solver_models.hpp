@@ -1,5 +1,6 @@
 // What the solver tests share (test_solver.cpp, test_cpdi_domains.cpp,
-// test_time_loop.cpp): the report's solid, a disk of particles on a small
+// test_cpdi_corners.cpp, test_time_loop.cpp, test_stable_step.cpp,
+// test_time_step_scan.cpp): the report's solid, a disk of particles on a small
 // grid, stepping it, its momentum, and observers and options for short runs.
 #pragma once
 
