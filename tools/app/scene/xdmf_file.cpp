@@ -1,7 +1,6 @@
 #include "xdmf_file.hpp"
 
 #include <algorithm>
-#include <cstdio>
 #include <filesystem>
 #include <stdexcept>
 #include <vector>
@@ -40,15 +39,16 @@ struct Field {
   const char* type;  // the XDMF AttributeType
 };
 
-// One point set at one time: group `path` of the file, its positions, the
+// One point set at one time: group `path` of the file, its `position`, the
 // fields it has of `fields`.
-std::string grid_text(const h5::Group& group, const std::string& path, const char* position, double time,
-                      const std::vector<Field>& fields, const std::string& file, hsize_t index_count) {
-  const std::vector<hsize_t> points = group.dimensions(position);
+std::string grid_text(const h5::Group& group, const std::string& path, double time, const std::vector<Field>& fields,
+                      const std::string& file, hsize_t index_count) {
+  const std::vector<hsize_t> points = group.dimensions("position");
   const hsize_t n = points.empty() ? 0 : points[0];
-  auto item = [&](const std::string& dataset, const std::vector<hsize_t>& dims, const char* number, int precision) {
-    return fmt::format("<DataItem Dimensions=\"{}\" NumberType=\"{}\" Precision=\"{}\" Format=\"HDF\">{}:{}/{}</DataItem>",
-                       dims_text(dims), number, precision, file, path, dataset);
+  // A dataset of the group, as doubles.
+  auto item = [&](const std::string& dataset, const std::vector<hsize_t>& dims) {
+    return fmt::format("<DataItem Dimensions=\"{}\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">{}:{}/{}</DataItem>",
+                       dims_text(dims), file, path, dataset);
   };
   // Polyvertex cells, one per particle, from the first n entries of /particle_index.
   std::string s = fmt::format("   <Grid Name=\"t = {:.6g} s\" GridType=\"Uniform\">\n    <Time Value=\"{:.17g}\"/>\n",
@@ -59,11 +59,11 @@ std::string grid_text(const h5::Group& group, const std::string& path, const cha
                    "      <DataItem Dimensions=\"{}\" NumberType=\"Int\" Precision=\"8\" Format=\"HDF\">{}:/particle_index</DataItem>\n"
                    "     </DataItem>\n    </Topology>\n",
                    n, n, n, index_count, file);
-  s += fmt::format("    <Geometry GeometryType=\"XY\">\n     {}\n    </Geometry>\n", item(position, points, "Float", 8));
+  s += fmt::format("    <Geometry GeometryType=\"XY\">\n     {}\n    </Geometry>\n", item("position", points));
   for (const Field& f : fields) {
     if (!group.has(f.name)) continue;
     s += fmt::format("    <Attribute Name=\"{}\" AttributeType=\"{}\" Center=\"Node\">\n     {}\n    </Attribute>\n",
-                     f.name, f.type, item(f.name, group.dimensions(f.name), "Float", 8));
+                     f.name, f.type, item(f.name, group.dimensions(f.name)));
   }
   return s + "   </Grid>\n";
 }
@@ -100,14 +100,13 @@ std::string xdmf_text(const std::string& h5_path) {
     for (const std::string& k : members) {
       const h5::Group g = all.open_group(k);
       last = g.attribute_double("time");
-      grids += grid_text(g, "/snapshots/" + k, "position", last, snapshot_fields, name, index_count);
+      grids += grid_text(g, "/snapshots/" + k, last, snapshot_fields, name, index_count);
     }
   }
   // The end state, unless the last output is it (a run that stopped between
   // outputs adds the state it stopped at).
   const double end = root.attribute_double("time_reached");
-  if (end > last) grids += grid_text(root.open_group("particles"), "/particles", "position", end, end_fields, name,
-                                     index_count);
+  if (end > last) grids += grid_text(root.open_group("particles"), "/particles", end, end_fields, name, index_count);
   return "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n <Domain>\n"
          "  <Grid Name=\"particles\" GridType=\"Collection\" CollectionType=\"Temporal\">\n" +
          grids + "  </Grid>\n </Domain>\n</Xdmf>\n";
