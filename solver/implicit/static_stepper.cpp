@@ -11,6 +11,7 @@
 
 #include <fmt/format.h>
 
+#include "active_set.hpp"
 #include "load_work.hpp"
 #include "newton_krylov.hpp"
 #include "tangent.hpp"
@@ -63,26 +64,19 @@ class StaticStepper final : public Stepper {
     particles_to_grid<kMass>(shape, P, buffers_, fields_);
     if (body_force_) body_force_->evaluate(t + dt, P, P.body_force);
 
-    // The master's motion over the step and the gap of every node (contact.hpp).
-    Vec2 master_step = Vec2::Zero();
-    if (contact_) {
-      master_step = contact_->displacement(t + dt) - contact_->displacement(t);
-      ContactScratch scratch;
-      node_contact_gaps(*contact_, shape, P, model_.grid, t, 3.0 * model_.grid.h + master_step.norm(), scratch);
-      gap_ = scratch.node_gap;
-      if (active_.size() != nodes) active_.assign(nodes, 0);
-    }
+    contact_.start_step(shape, P, model_.grid, t, dt);
 
     std::vector<double> q;
     NewtonKrylovResult result;
     u_.assign(nodes, Vec2::Zero());
     for (int pass = 0;; ++pass) {
-      const ContactUnknowns in_contact{contact_ ? &*contact_ : nullptr, active_, gap_, master_step};
-      unknowns_.build(model_.grid, fields_.mass, constraints_, in_contact, t, dt);
+      unknowns_.build(model_.grid, fields_.mass, constraints_, contact_.unknowns(), t, dt);
       unknowns_.closest(u_, q);
       result = solve(shape, q);
       if (!result.converged) break;
-      if (!contact_ || !update_active_set(shape, q, master_step)) break;
+      if (!contact_.has_master()) break;
+      residual_at(shape, q);  // u_ and fields_.force at the solution
+      if (!contact_.update(model_.grid, fields_, u_)) break;
       if (pass + 1 >= options_.max_contact_passes) {
         failure_ = fmt::format("contact active set still changing after {} passes", options_.max_contact_passes);
         break;
@@ -231,34 +225,6 @@ class StaticStepper final : public Stepper {
     return out;
   }
 
-  // ------------------------------------------------------------ contact
-
-  // After a solve: nodes whose contact force pulls are released, nodes that
-  // would cross the master join. Returns whether the set changed.
-  bool update_active_set(const Shape& shape, const std::vector<double>& q, const Vec2& master_step) {
-    residual_at(shape, q);
-    const GridGeometry& grid = model_.grid;
-    bool changed = false;
-    const double t = time_;
-    for (int j = wall_node_y(grid, 0); j <= wall_node_y(grid, 1); ++j)
-      for (int i = wall_node_x(grid, 0); i <= wall_node_x(grid, 1); ++i) {
-        const std::size_t node = std::size_t(grid.node(i, j));
-        if (!(fields_.mass[node] > 0.0) || !std::isfinite(gap_[node])) continue;
-        const Vec2 n = contact_->normal(grid.node_position(i, j), t);
-        if (active_[node]) {
-          // The master's push on the body, -(f_ext - f_int) along n, must be positive.
-          if (-fields_.force[node].dot(n) < 0.0) {
-            active_[node] = 0;
-            changed = true;
-          }
-        } else if ((u_[node] - master_step).dot(n) < -gap_[node] - 1e-12 * grid.h) {
-          active_[node] = 1;
-          changed = true;
-        }
-      }
-    return changed;
-  }
-
   void residual_at(const Shape& shape, const std::vector<double>& q) {
     std::vector<double> r(q.size());
     residual(shape, q, r);
@@ -272,7 +238,7 @@ class StaticStepper final : public Stepper {
     // The work of the loads over the step (load_work.hpp).
     book_constraint_work(constraints_, fields_, time_, dt, reactions_, ledger_);
     if (body_force_) book_body_force_work(shape, P, u_, previous_body_force_, ledger_);
-    if (contact_) book_contact_work(active_, fields_, u_, contact_forces_, ledger_);
+    if (contact_.has_master()) book_contact_work(contact_.active(), fields_, u_, contact_forces_, ledger_);
     // Tracers move with the grid's displacement, as in the explicit step
     // (mass-weighted, stages.hpp).
     if (!model_.tracers.empty()) {
@@ -301,7 +267,7 @@ class StaticStepper final : public Stepper {
   Material material_;
   std::shared_ptr<BodyForce> body_force_;
   std::vector<NodeConstraint> constraints_;
-  std::optional<RigidBody> contact_;
+  ActiveContactSet contact_;
   StaticOptions options_;
   SmallStrainModuli moduli_{};
   double force_scale_ = 1.0;
@@ -313,8 +279,6 @@ class StaticStepper final : public Stepper {
   GridUnknowns unknowns_;
   std::vector<Vec2> u_;  // the node displacements of the last residual's unknowns
   SmallStrainTangent tangent_;
-  std::vector<double> gap_;
-  std::vector<unsigned char> active_;
   std::string failure_;
   long newton_iterations_ = 0, linear_iterations_ = 0, residual_evaluations_ = 0, solves_ = 0;
   Remaining remaining_;
