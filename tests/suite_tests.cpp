@@ -1,6 +1,6 @@
-// Suites: the file is read and checked before anything runs; the runner keeps
-// every case in a process of its own, resumes, shares cases over MPI ranks;
-// the gate catches real faults. These tests run whole suites through the
+// The suite runner keeps every case in a process of its own, resumes, shares
+// cases over MPI ranks; the gate catches real faults (the suite file's own
+// checks: suite_file_tests.cpp). These tests run whole suites through the
 // built `mpmvv`, so ctest runs them one at a time.
 #include <gtest/gtest.h>
 
@@ -14,7 +14,6 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <regex>
 #include <sstream>
 #include <string>
 
@@ -28,16 +27,6 @@
 namespace {
 
 using namespace mpmvv::suite_testing;
-using mpmvv::app::ConfigError;
-
-std::string config_error(const fs::path& suite) {
-  try {
-    mpmvv::app::load_suite(suite.string());
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
 
 // Three quick cases of the axis-aligned problem.
 std::string small_suite(double timeout = 120) {
@@ -46,139 +35,6 @@ std::string small_suite(double timeout = 120) {
 }
 
 }  // namespace
-
-// Sweep lists form a product (the last key fastest), zipped lists go together,
-// overrides reach the cases they match, and ids name the swept values in file
-// order.
-TEST(SuiteFile, ExpandsSweepZipAndOverrides) {
-  const fs::path dir = scratch("expand");
-  const fs::path suite = write(dir / "s.toml", "[[study]]\nname = \"r\"\nscene = \"" + kScenes + "/ring.toml\"\n"
-                                               "set = { end_time = 0.25 }\n"
-                                               "sweep = { method = [\"gimp\", \"cpdi\"], cells = [32, 64] }\n"
-                                               "zip = { particles_per_direction = [2, 3], cfl = [0.3, 0.2] }\n"
-                                               "[[study.override]]\nwhere = { cells = 64, method = \"cpdi\" }\n"
-                                               "set = { probe_points = 11 }\n");
-  const mpmvv::app::Suite s = mpmvv::app::load_suite(suite.string());
-  ASSERT_EQ(s.cases.size(), 8u);
-  EXPECT_EQ(s.cases[0].id, "r-method=gimp-cells=32-particles_per_direction=2-cfl=0.3");
-  EXPECT_EQ(s.cases[1].id, "r-method=gimp-cells=32-particles_per_direction=3-cfl=0.2");
-  EXPECT_EQ(s.cases[2].id, "r-method=gimp-cells=64-particles_per_direction=2-cfl=0.3");
-  EXPECT_EQ(s.cases[7].id, "r-method=cpdi-cells=64-particles_per_direction=3-cfl=0.2");
-  int overridden = 0;
-  for (const auto& c : s.cases) {
-    const bool match = c.keys.at("cells") == 64 && c.keys.at("method") == "cpdi";
-    overridden += match;
-    EXPECT_EQ(c.keys.at("probe_points"), match ? 11 : 51) << c.id;
-    EXPECT_NE(c.configuration.find("end_time = 0.25"), std::string::npos) << c.id;
-  }
-  EXPECT_EQ(overridden, 2);
-}
-
-// A zipped list may repeat a value when the tuples differ (the explicit step
-// with two dilatations beside the implicit one).
-TEST(SuiteFile, ZipRepeatsAValueInDistinctTuples) {
-  const fs::path dir = scratch("zip-repeat");
-  const fs::path suite = write(dir / "s.toml", "[[study]]\nname = \"r\"\nscene = \"" + kScenes + "/ring.toml\"\n"
-                                               "zip = { method = [\"cpdi\", \"cpdi\", \"gimp\"], cfl = [0.3, 0.2, 0.3] }\n");
-  const mpmvv::app::Suite s = mpmvv::app::load_suite(suite.string());
-  ASSERT_EQ(s.cases.size(), 3u);
-  EXPECT_EQ(s.cases[0].id, "r-method=cpdi-cfl=0.3");
-  EXPECT_EQ(s.cases[1].id, "r-method=cpdi-cfl=0.2");
-  EXPECT_EQ(s.cases[2].id, "r-method=gimp-cfl=0.3");
-}
-
-// Every mistake is one message naming the file, the line and the key, before
-// anything runs.
-TEST(SuiteFile, MistakesNameFileLineAndKey) {
-  const fs::path dir = scratch("mistakes");
-  const std::string study = "[[study]]\nname = \"a\"\nscene = \"" + kScenes + "/ring.toml\"\n";
-  struct Case {
-    std::string text, mentions;
-  };
-  const Case cases[] = {
-      {study + "sweep = { cells = [32, 64], nokey = [1] }\n", "s.toml:4: sweep: unknown key 'nokey'"},
-      {study + "sweep = { cells = [32, 2] }\n", "s.toml:4: key 'cells' must be an integer in [4, 20000], got 2"},
-      {study + "set = { density = -1 }\n", "s.toml:4: key 'density' must be a number > 0"},
-      {study + "zip = { cells = [32, 64], cfl = [0.3] }\n", "zipped lists must be equally long"},
-      {study + "foo = 1\n", "s.toml:4: unknown key 'foo' in [[study]]"},
-      {study + "set = { cells = 32 }\nsweep = { cells = [32, 64] }\n", "key 'cells' is given twice"},
-      {study + "sweep = { cells = [32, 32] }\n", "'cells' lists 32 twice"},
-      {study + "zip = { cells = [32, 64, 32], cfl = [0.3, 0.3, 0.3] }\n",
-       "s.toml:4: zip: entries 1 and 3 are the same (cells=32, cfl=0.3)"},
-      {"[[study]]\nname = \"a\"\nscene = \"nope.toml\"\n", "s.toml:3: study 'a': no such scene file"},
-      {study + "[[expect]]\nstudy = \"b\"\nnorm = \"L1\"\norder = 2\ntolerance = 0.1\n", "s.toml:5: [[expect]]: no study named 'b'"},
-      {study + "sweep = { cells = [32, 64] }\n[[expect]]\nstudy = \"a\"\nnorm = \"L1_theta0\"\norder = 2\n",
-       "[[expect]] needs 'tolerance'"},
-      {study + "sweep = { cells = [32, 64] }\n[[expect]]\nstudy = \"a\"\nnorm = \"L1_theta0\"\norder = 2\ntolerance = 0.1\n"
-               "levels = [32, 128]\n",
-       "study 'a' has no case with cells = 128"},
-      {study + "sweep = { cells = [32, 64] }\n[[expect]]\nstudy = \"a\"\nnorm = \"L1_theta0\"\nmax_error = 1.0\n"
-               "interval_within_band = true\n",
-       "'interval_within_band' needs an 'order'"},
-      {study + "sweep = { cells = [32, 64] }\n[[expect]]\nstudy = \"a\"\nnorm = \"L1_theta0\"\norder = nan\n"
-               "tolerance = 0.1\n",
-       "[[expect]] holds a value that is not a finite number (nan or inf)"},
-      {study + "sweep = { cells = [32, 64] }\n[[expect]]\nstudy = \"a\"\nnorm = \"L1_theta0\"\norder = 2\n"
-               "tolerance = 0.1\ninterval_within_band = 1\n",
-       "'interval_within_band' must be true or false"},
-      {study + "set = { inner_radius = 1.3 }\n", "key 'outer_radius': must exceed inner_radius = 1.3 (from"},
-      {study + "sweep = { cells = [32, 64] }\n[[reference]]\nsource = \"x\"\nstudy = \"a\"\nquantity = \"time_reached\"\n"
-               "columns = [\"cells\"]\nrows = [[32, 0.4], [128, 0.3]]\n",
-       "s.toml:10: [[reference]]: the row cells=128 matches no case of study 'a'"},
-      {study + "sweep = { cells = [32, 64] }\n[[reference]]\nsource = \"x\"\nstudy = \"a\"\nquantity = \"time_reached\"\n"
-               "columns = [\"cels\"]\nrows = [[32, 0.4]]\n",
-       "s.toml:9: [[reference]]: column 'cels' is not a key of study 'a'"},
-      {study + "[[reference]]\nsource = \"x\"\nstudy = \"a\"\nquantity = \"speed\"\nrows = [[0.4]]\n",
-       "s.toml:7: [[reference]] needs 'quantity': \"time_reached\", \"error\" or \"order\""},
-      {study + "[[reference]]\nsource = \"x\"\nstudy = \"a\"\nquantity = \"error\"\nrows = [[0.1]]\n",
-       "s.toml:4: [[reference]]: an error needs 'norm'"},
-      {study + "[[reference]]\nsource = \"x\"\nstudy = \"a\"\nquantity = \"error\"\nnorm = \"particle_L2\"\n"
-               "rows = [[-0.1]]\n",
-       "the last value of a row is the error, a non-negative number"},
-      {study + "[[reference]]\nsource = \"x\"\nstudy = [\"a\", \"b\"]\nquantity = \"order\"\nnorm = \"L1_theta0\"\nrows = [[2.0]]\n",
-       "s.toml:6: [[reference]]: no study named 'b'"},
-      {study + "[[reference]]\nsource = \"x\"\nstudy = \"a\"\nquantity = \"order\"\nrows = [[2.0]]\n",
-       "s.toml:4: [[reference]]: an order needs 'norm'"},
-      {study + "[[reference]]\nsource = \"x\"\nstudy = \"a\"\nquantity = \"time_reached\"\ncolumns = [\"cells\"]\n"
-               "rows = [[64]]\n",
-       "each row holds a value for each of the 1 columns, then the time_reached"},
-      {study + "[[reference]]\nstudy = \"a\"\nquantity = \"time_reached\"\nrows = [[-1.0]]\n",
-       "s.toml:4: [[reference]] needs a source"},
-      {study + "[[reference]]\nsource = \"x\"\nstudy = \"a\"\nquantity = \"time_reached\"\nrows = [[-1.0]]\n",
-       "the last value of a row is the time_reached, a non-negative number"},
-      {study + "[[reference]]\nsource = \"x\"\nstudy = \"a\"\nquantity = \"time_reached\"\nrows = [[1.0]]\nlevel = 3\n",
-       "s.toml:9: unknown key 'level' in [[reference]]"},
-      {"[[study]]\nname = \"a b\"\n", "may hold only letters, digits"},
-      {"[[study]]\nname = \"" + std::string(240, 'x') + "\"\nscene = \"" + kScenes +
-           "/ring.toml\"\nsweep = { cells = [32] }\n",
-       "characters long, more than the 244 a file name leaves it"},
-      {"[[study]\n", "TOML syntax error"},
-      {"checkpoint_every = -5\n" + study, "s.toml:1: 'checkpoint_every' must be a positive number of seconds"},
-  };
-  for (const Case& c : cases) {
-    const std::string message = config_error(write(dir / "s.toml", c.text));
-    EXPECT_NE(message.find(c.mentions), std::string::npos) << "message: " << message << "\nexpected: " << c.mentions;
-  }
-}
-
-// Published numbers beside the suite's own: the shipped Sandia suite's
-// [[reference]] tables (table 3.2 and the order of figure 3.5 of
-// 000_1dbcb8acb6dddab9.txt) load, every row matching its cases; the same row
-// with an amplitude the study does not sweep is refused.
-TEST(SuiteFile, ReferencesMatchTheirCases) {
-  const std::string sandia = std::string(MPMVV_SOURCE_DIR) + "/suites/ring-sandia.toml";
-  EXPECT_EQ(config_error(sandia), "(no error)");
-  std::string text = read(sandia);
-  const std::string row = "[300, 2, 1.0, 0.47]";
-  ASSERT_NE(text.find(row), std::string::npos);
-  text.replace(text.find(row), row.size(), "[300, 2, 0.75, 0.47]");
-  const fs::path dir = scratch("references");
-  fs::copy(std::string(MPMVV_SOURCE_DIR) + "/suites/scenes", dir / "scenes");
-  const std::string message = config_error(write(dir / "ring-sandia.toml", text));
-  EXPECT_NE(message.find("[[reference]]: the row cells=300, particles_per_direction=2, amplitude=0.75 matches no case of its studies"),
-            std::string::npos)
-      << message;
-}
 
 // A case that crashes or hangs fails alone: the others complete, the manifest
 // says which ended how, no half-written results file remains, exit status 1.
@@ -396,25 +252,6 @@ TEST(SuiteRunner, AFullDiskEndsACaseOrTheSuiteWithOneLine) {
   const std::string resumed = read(out / "manifest.json");
   EXPECT_EQ(cases_with_status(resumed, "completed"), 3) << resumed;
   EXPECT_EQ(count(resumed, "kept from an earlier run"), 2) << resumed;
-}
-
-// An expectation read where the exact signal is trivial (the r-z cylinder at
-// t = 1 s, where its exact displacement is zero) is warned about when the
-// suite is loaded, before anything runs, naming the file and line; one read
-// where the motion is large is not.
-TEST(SuiteFile, WarnsOfAReadWhereTheExactSignalIsTrivial) {
-  const fs::path dir = scratch("trivial-read");
-  const fs::path suite = write(dir / "s.toml", "[[study]]\nname = \"rz\"\nscene = \"" + kScenes +
-                                                   "/rz-cylinder.toml\"\nsweep = { cells = [8, 16] }\n"
-                                                   "[[expect]]\nstudy = \"rz\"\nnorm = \"particle_L2\"\n"
-                                                   "time = 1.0\norder = 2.0\ntolerance = 0.3\n"
-                                                   "[[expect]]\nstudy = \"rz\"\nnorm = \"L1_line_z_quarter\"\n"
-                                                   "time = 0.25\norder = 2.0\ntolerance = 0.3\n");
-  const mpmvv::app::Suite loaded = mpmvv::app::load_suite(suite.string());
-  ASSERT_EQ(loaded.warnings.size(), 1u);
-  EXPECT_NE(loaded.warnings[0].find("s.toml:5"), std::string::npos) << loaded.warnings[0];
-  EXPECT_NE(loaded.warnings[0].find("particle_L2 at t = 1 where the exact signal is 0 %"), std::string::npos)
-      << loaded.warnings[0];
 }
 
 // --only runs the cases whose id the regular expression finds and leaves the
