@@ -179,15 +179,18 @@ def contact_pressure_figure(study, all_series, directory):
             marks = [(a * 1e3, "a")]
         panels.append(figures.LinePanel(title, curves, exact, marks))
     when = time_text(common) if all(math.isclose(t, common) for t in last_times) else "the last output of each case"
-    figure = figures.pressure_profiles(panels, f"{study}: contact pressure at {when}", "distance x from the axis [mm]",
-                                       "contact pressure [MPa]")
+    # In r-z the distance from the axis is the radius r, and a the contact's radius.
+    radial = all(case.attribute("geometry", "") == "axisymmetric" for _, profiles in found for case, _ in profiles)
+    x, width = ("r", "contact radius") if radial else ("x", "half-width")
+    figure = figures.pressure_profiles(panels, f"{study}: contact pressure at {when}",
+                                       f"distance {x} from the axis [mm]", "contact pressure [MPa]")
     path = saved(figure, directory, study, 'contact-pressure')
     refine = found[0][0].refine
-    return FigureEntry(study, path, f"{study}: contact pressure on the plate [MPa] against distance x from the axis "
+    return FigureEntry(study, path, f"{study}: contact pressure on the plate [MPa] against distance {x} from the axis "
                                     f"[mm] at {when} (/probes/contact_pressure); markers: simulated at the cell "
                                     f"midpoints, one series per {refine} level; line: the exact (Hertz) pressure "
-                                    f"p0 sqrt(1 - x^2/a^2) at the load the finest case measured, dotted at its "
-                                    f"half-width a; x up to twice the largest x where that exact pressure is "
+                                    f"p0 sqrt(1 - {x}^2/a^2) at the load the finest case measured, dotted at its "
+                                    f"{width} a; {x} up to twice the largest {x} where that exact pressure is "
                                     f"nonzero.")
 
 

@@ -69,6 +69,38 @@ TEST(Hertz, SphereLoadAndApproachAgree) {
   EXPECT_NEAR(HertzSphere::load_at_approach(s.approach(), s.radius, s.contact_modulus) / s.load, 1.0, 1e-13);
 }
 
+// The sphere's stresses on the axis: at the surface sigma_z = -p0 and
+// sigma_r = -(1 + 2 nu) p0 / 2; sigma_z at depth equals the sum of
+// Boussinesq's point-load stresses, -3 P z^3 / (2 pi rho^5), over the Hertz
+// pressure (an independent integral); the largest shear (sigma_r - sigma_z)/2
+// is 0.31 p0 at z = 0.48 a for nu = 0.3 (Johnson, section 3.4).
+TEST(Hertz, SphereAxisStressesAgreeWithBoussinesq) {
+  const double nu = 0.3;
+  const HertzSphere s{1000.0, 0.05, contact_modulus_rigid(210e9, nu)};
+  const double a = s.contact_radius(), p0 = s.peak_pressure();
+  EXPECT_NEAR(s.axis_sigma_z(0.0) / p0, -1.0, 1e-15);
+  EXPECT_NEAR(s.axis_sigma_r(0.0, nu) / p0, -(1.0 + 2.0 * nu) / 2.0, 1e-15);
+  for (double z : {0.25 * a, a, 3.0 * a}) {
+    // r = a sin(t) takes the square root's end point out of the integrand.
+    const double boussinesq = integrate(
+        [&](double t) {
+          const double r = a * std::sin(t), rho2 = r * r + z * z;
+          const double pressure = p0 * std::cos(t);
+          return -3.0 * z * z * z / (2.0 * pi * std::pow(rho2, 2.5)) * pressure * 2.0 * pi * r * a * std::cos(t);
+        },
+        0.0, pi / 2.0);
+    EXPECT_NEAR(s.axis_sigma_z(z) / boussinesq, 1.0, 1e-9) << "z / a = " << z / a;
+  }
+  double best = 0.0, depth = 0.0;
+  for (int k = 1; k <= 20000; ++k) {
+    const double z = 1e-4 * k * a;
+    const double shear = 0.5 * (s.axis_sigma_r(z, nu) - s.axis_sigma_z(z));
+    if (shear > best) best = shear, depth = z;
+  }
+  EXPECT_NEAR(best / p0, 0.31, 0.005);
+  EXPECT_NEAR(depth / a, 0.48, 0.005);
+}
+
 // Plane strain small-strain formulas follow from 3D Hooke's law with
 // eps_zz = 0 and sigma_yy = 0; plane stress and 3D give E and -nu; the seed's
 // lateral change tends to -nu d eps at small strain.

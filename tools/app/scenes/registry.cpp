@@ -14,6 +14,7 @@
   SCENE(uniaxial_compression_scene)         \
   SCENE(shear_scene)                        \
   SCENE(hertz_cylinder_scene)               \
+  SCENE(hertz_sphere_scene)                 \
   NEEDS_SUNDIALS(neo_hookean_bar_scene)     \
   NEEDS_SUNDIALS(layered_bar_scene)
 
