@@ -33,6 +33,7 @@ class Case final : public SceneCase, private RunObserver {
       : config_(config), setup_(type.setup(config)), options_(solver_options(config)),
         loop_(time_loop_options(config)), probes_(setup_) {
     options_.geometry = setup_.geometry;
+    if (setup_.run_refused) config_.reject(setup_.run_refused->key, setup_.run_refused->why);
     exact_seeding_ = config_.text("seeding") == "exact";
     if (implicit() && config_.integer("stable_step_iterations") > 0)
       config_.reject("stable_step_iterations",

@@ -121,6 +121,14 @@ struct SceneSetup {
   // shows it), used instead of automatic differentiation for speed; absent
   // otherwise.
   std::shared_ptr<mms::ForceField> fast_body_force;
+  // Why a run of this setup would not verify anything, and the key to blame
+  // (a manufactured motion its boundary conditions cannot hold): a run or a
+  // suite refuses it with that message, while `mms eval`, `mms check` and the
+  // library still evaluate the solution. Absent: it runs.
+  struct Refusal {
+    std::string key, why;
+  };
+  std::optional<Refusal> run_refused;
   // A scene that settles to a static state (scenes/quasi_static.hpp): what
   // the results file's measurements settling_displacement and settling_strain,
   // how far its end still is from that state, are measured from (settling.hpp).

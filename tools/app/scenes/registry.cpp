@@ -15,6 +15,7 @@
   SCENE(shear_scene)                        \
   SCENE(hertz_cylinder_scene)               \
   SCENE(hertz_sphere_scene)                 \
+  SCENE(user_motion_scene)                  \
   NEEDS_SUNDIALS(neo_hookean_bar_scene)     \
   NEEDS_SUNDIALS(layered_bar_scene)
 
