@@ -62,6 +62,10 @@ class Expression {
     text_.clear();
   }
 
+  // Whether a name is taken by the formulas themselves (pi and the functions),
+  // so that a parameter may not have it.
+  static bool reserved(const std::string& name) { return name == "pi" || functions().count(name) > 0; }
+
   // Whether the formula reads variable k (0, 1: the coordinates; 2: time).
   bool reads(int k) const {
     for (const Operation& o : program_)
@@ -101,6 +105,12 @@ class Expression {
     int index = 0;       // variable: which
   };
 
+  static const std::map<std::string, Op>& functions() {
+    static const std::map<std::string, Op> table = {{"sin", Op::sin}, {"cos", Op::cos}, {"tan", Op::tan},
+                                                    {"exp", Op::exp}, {"log", Op::log}, {"sqrt", Op::sqrt}};
+    return table;
+  }
+
   template <class S>
   static S apply(const Operation& o, const S& x) {
     using std::cos, std::exp, std::log, std::pow, std::sin, std::sqrt;
@@ -136,54 +146,52 @@ class Expression {
     return true;
   }
 
+  // A folded constant must be a number: `why` names what made it none, at `column` (from 1).
+  static double folded(double value, const std::string& why, std::size_t column) {
+    if (!std::isfinite(value)) throw ExpressionError(why, column);
+    return value;
+  }
+  static constexpr const char* kNotFinite = "a constant part is not a finite number";
+
   // Pushes a binary operation, folding it when both operands are constants.
-  void binary(Op op, std::size_t left_start) {
+  void binary(Op op, std::size_t left_start, std::size_t column) {
     const std::size_t n = program_.size();
     if (n >= 2 && program_[n - 1].op == Op::constant && program_[n - 2].op == Op::constant &&
         left_start == n - 2) {
-      program_[n - 2].value = apply(op, program_[n - 2].value, program_[n - 1].value);
+      program_[n - 2].value = folded(apply(op, program_[n - 2].value, program_[n - 1].value), kNotFinite, column);
       program_.pop_back();
       return;
     }
     program_.push_back({op});
   }
-  void unary(const Operation& o, std::size_t start) {
+  void unary(const Operation& o, std::size_t start, const std::string& why, std::size_t column) {
     if (program_.size() == start + 1 && program_.back().op == Op::constant) {
-      program_.back().value = apply(o, program_.back().value);
+      program_.back().value = folded(apply(o, program_.back().value), why, column);
       return;
     }
     program_.push_back(o);
   }
 
-  void sum() {
+  // operand { (first | second) operand }, left to right: the sum of products
+  // and the product of factors.
+  void chain(void (Expression::*operand)(), char first, Op first_op, char second, Op second_op) {
     const std::size_t start = program_.size();
-    product();
+    (this->*operand)();
     for (;;) {
-      const std::size_t column = position_;
-      if (take('+')) product(), binary(Op::add, start), check_fold(column);
-      else if (take('-')) product(), binary(Op::subtract, start), check_fold(column);
-      else return;
+      const std::size_t column = position_ + 1;
+      const Op op = take(first) ? first_op : take(second) ? second_op : Op::constant;
+      if (op == Op::constant) return;
+      (this->*operand)();
+      binary(op, start, column);
     }
   }
-  void product() {
-    const std::size_t start = program_.size();
-    factor();
-    for (;;) {
-      const std::size_t column = position_;
-      if (take('*')) factor(), binary(Op::multiply, start), check_fold(column);
-      else if (take('/')) factor(), binary(Op::divide, start), check_fold(column);
-      else return;
-    }
-  }
-  void check_fold(std::size_t column) const {
-    if (!program_.empty() && program_.back().op == Op::constant && !std::isfinite(program_.back().value))
-      throw ExpressionError("a constant part is not a finite number", column + 1);
-  }
+  void sum() { chain(&Expression::product, '+', Op::add, '-', Op::subtract); }
+  void product() { chain(&Expression::factor, '*', Op::multiply, '/', Op::divide); }
   void factor() {
-    const std::size_t start = program_.size();
+    const std::size_t start = program_.size(), minus = position_ + 1;
     if (take('-')) {
       factor();
-      unary({Op::negate}, start);
+      unary({Op::negate}, start, kNotFinite, minus);
       return;
     }
     primary();
@@ -195,7 +203,7 @@ class Expression {
         throw ExpressionError("an exponent must be a constant", column + 1);
       const double p = program_.back().value;
       program_.pop_back();
-      unary({Op::power, p}, start);
+      unary({Op::power, p}, start, kNotFinite, column + 1);
     }
   }
   void primary() {
@@ -224,16 +232,12 @@ class Expression {
     std::string name;
     while (!at_end() && (std::isalnum(static_cast<unsigned char>(peek())) || peek() == '_')) name += text_[position_++];
     skip();
-    static const std::map<std::string, Op> functions = {{"sin", Op::sin}, {"cos", Op::cos}, {"tan", Op::tan},
-                                                       {"exp", Op::exp}, {"log", Op::log}, {"sqrt", Op::sqrt}};
-    if (const auto f = functions.find(name); f != functions.end()) {
+    if (const auto f = functions().find(name); f != functions().end()) {
       if (!take('(')) throw ExpressionError("'" + name + "' needs its argument in parentheses", position_ + 1);
       const std::size_t start = program_.size();
       sum();
       if (!take(')')) throw ExpressionError("missing ')'", position_ + 1);
-      unary({f->second}, start);
-      if (program_.back().op == Op::constant && !std::isfinite(program_.back().value))
-        throw ExpressionError("'" + name + "' of a constant that is out of its domain", column);
+      unary({f->second}, start, "'" + name + "' of a constant that is out of its domain", column);
       return;
     }
     for (int k = 0; k < kVariables; ++k)

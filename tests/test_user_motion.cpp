@@ -86,6 +86,7 @@ TEST(Expression, MistakesNameTheirPlace) {
   EXPECT_EQ(error_of("sin X"), "'sin' needs its argument in parentheses at character 5");
   EXPECT_EQ(error_of("X + 1 / 0"), "a constant part is not a finite number at character 7");
   EXPECT_EQ(error_of("sqrt(-1) * X"), "'sqrt' of a constant that is out of its domain at character 1");
+  EXPECT_EQ(error_of("X * 0 ^ -1"), "a constant part is not a finite number at character 7");
 }
 
 namespace {

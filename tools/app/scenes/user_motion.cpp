@@ -74,8 +74,8 @@ std::map<std::string, double> read_parameters(const Config& c) {
     if (!(std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_') ||
         !std::all_of(name.begin(), name.end(), [](char ch) { return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_'; }))
       c.reject("parameters", fmt::format("'{}' is not a name (letters, digits, _)", name));
-    for (const char* taken : {"X", "Y", "t", "pi", "sin", "cos", "tan", "exp", "log", "sqrt"})
-      if (name == taken) c.reject("parameters", fmt::format("'{}' is a coordinate, time, pi or a function", name));
+    if (name == "X" || name == "Y" || name == "t" || mms::Expression::reserved(name))
+      c.reject("parameters", fmt::format("'{}' is a coordinate, time, pi or a function", name));
     if (parameters.count(name)) c.reject("parameters", fmt::format("'{}' is given twice", name));
     try {
       const mms::Expression value(item.substr(equals + 1), {"", "", ""}, parameters);
