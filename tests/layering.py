@@ -3,7 +3,7 @@ inside"): the solver, the manufactured and the exact solutions know nothing of
 the application; in tools/app/ the shared pieces (config, fault, json,
 toml_file) know no scene, a scene's generic layer (scene/) names no scene and
 no suite, each scene (scenes/) knows no suite, and nothing includes a command
-(run_case, mms_command) but the command line. No header reaches itself.
+(run_case, mms_command, material_drive) but the command line. No header reaches itself.
 
     /usr/bin/python3 tests/layering.py ROOT   (ctest runs it; exit 1 names each breach)
 """
@@ -18,7 +18,7 @@ INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
 LAYERS = [
     ("solver/", "low"), ("mms/", "low"), ("analytic/", "low"),
     ("tools/app/scene/", "scene"), ("tools/app/scenes/", "scenes"), ("tools/app/suite/", "suite"),
-    ("tools/app/run_case", "command"), ("tools/app/mms_command", "command"),
+    ("tools/app/run_case", "command"), ("tools/app/mms_command", "command"), ("tools/app/material_drive", "command"),
     ("tools/app/", "shared"), ("tools/cli/", "cli"), ("tools/bench/", "cli"), ("tools/lib/", "cli"), ("tests/", "cli"),
 ]
 FORBIDDEN = {

@@ -346,7 +346,7 @@ TEST(StoredEnergy, VanishesAtRestAndDifferentiatesToTheStress) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> d(-0.3, 0.3);
   auto check = [&](const auto& material, const char* name) {
-    EXPECT_NEAR(material.energy_density(mpmvv::Mat2::Identity(), 1.0), 0.0, 1e-12) << name;
+    EXPECT_NEAR(material.energy_density(mpmvv::Mat2(mpmvv::Mat2::Identity()), 1.0), 0.0, 1e-12) << name;
     for (int k = 0; k < 50; ++k) {
       mpmvv::Mat2 F;
       F << 1.0 + d(rng), d(rng), d(rng), 1.0 + d(rng);

@@ -12,6 +12,7 @@ namespace mpmvv {
 
 struct LinearElastic {
   static constexpr const char* name = "linear-elastic";
+  static constexpr bool finite_strain = false;  // not objective; sigma is dW/d(grad u)
   double lambda;  // [Pa]
   double mu;      // [Pa]
 
@@ -30,11 +31,14 @@ struct LinearElastic {
   }
 
   // Stored energy per reference volume, lambda/2 (tr eps)^2 + mu eps:eps.
-  double energy_density(const Mat2& F, double F33) const {
-    const Mat2 eps = 0.5 * (F + F.transpose()) - Mat2::Identity();
-    const double eps33 = F33 - 1.0;
-    const double trace = eps.trace() + eps33;
-    return 0.5 * lambda * trace * trace + mu * (eps.squaredNorm() + eps33 * eps33);
+  // Generic over the scalar so that the material driver differentiates it.
+  template <class T>
+  T energy_density(const Eigen::Matrix<T, 2, 2>& F, const T& F33) const {
+    using M = Eigen::Matrix<T, 2, 2>;
+    const M eps = T(0.5) * (F + F.transpose()) - M::Identity();
+    const T eps33 = F33 - T(1.0);
+    const T trace = eps.trace() + eps33;
+    return T(0.5 * lambda) * trace * trace + T(mu) * (eps.squaredNorm() + eps33 * eps33);
   }
 
   double p_wave_modulus() const { return lambda + 2.0 * mu; }

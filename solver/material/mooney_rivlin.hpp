@@ -19,6 +19,7 @@ namespace mpmvv {
 
 struct MooneyRivlin {
   static constexpr const char* name = "mooney-rivlin";
+  static constexpr bool finite_strain = true;  // objective; sigma is J^-1 dW/dF F^T
   double c1;             // [Pa]
   double c2;             // [Pa]
   double bulk_modulus;   // K [Pa]
@@ -49,15 +50,19 @@ struct MooneyRivlin {
   }
 
   // Stored energy per reference volume, W above.
-  double energy_density(const Mat2& F, double F33) const {
-    const double J = determinant(F) * F33;
-    const Mat2 B = F * F.transpose();
-    const double b33 = F33 * F33;
-    const double j23 = std::pow(J, -2.0 / 3.0);
-    const double i1_bar = j23 * (B.trace() + b33);
-    const double i2_bar = j23 * j23 * (determinant(B) + B.trace() * b33);
-    const double lnJ = std::log(J);
-    return c1 * (i1_bar - 3.0) + c2 * (i2_bar - 3.0) + 0.5 * bulk_modulus * lnJ * lnJ;
+  // Generic over the scalar so that the material driver differentiates it.
+  template <class T>
+  T energy_density(const Eigen::Matrix<T, 2, 2>& F, const T& F33) const {
+    using std::log;
+    using std::pow;
+    const T J = (F(0, 0) * F(1, 1) - F(0, 1) * F(1, 0)) * F33;
+    const Eigen::Matrix<T, 2, 2> B = F * F.transpose();
+    const T b33 = F33 * F33;
+    const T j23 = pow(J, -2.0 / 3.0);
+    const T i1_bar = j23 * (B.trace() + b33);
+    const T i2_bar = j23 * j23 * ((B(0, 0) * B(1, 1) - B(0, 1) * B(1, 0)) + B.trace() * b33);
+    const T lnJ = log(J);
+    return T(c1) * (i1_bar - T(3.0)) + T(c2) * (i2_bar - T(3.0)) + T(0.5 * bulk_modulus) * lnJ * lnJ;
   }
 
   double shear_modulus() const { return 2.0 * (c1 + c2); }

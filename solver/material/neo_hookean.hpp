@@ -16,6 +16,7 @@ namespace mpmvv {
 
 struct NeoHookean {
   static constexpr const char* name = "neo-hookean";
+  static constexpr bool finite_strain = true;  // objective; sigma is J^-1 dW/dF F^T
   double lambda;  // first Lame constant [Pa]
   double mu;      // shear modulus [Pa]
 
@@ -48,12 +49,15 @@ struct NeoHookean {
   }
 
   // Stored energy per reference volume, psi = mu/2 (I1 - 3) - mu ln J +
-  // lambda/2 (ln J)^2, whose Kirchhoff stress is the stress above.
-  double energy_density(const Mat2& F, double F33) const {
-    const double J = determinant(F) * F33;
-    const double I1 = (F * F.transpose()).trace() + F33 * F33;
-    const double lnJ = std::log(J);
-    return 0.5 * mu * (I1 - 3.0) - mu * lnJ + 0.5 * lambda * lnJ * lnJ;
+  // lambda/2 (ln J)^2, whose Kirchhoff stress is the stress above. Generic
+  // over the scalar so that the material driver differentiates it.
+  template <class T>
+  T energy_density(const Eigen::Matrix<T, 2, 2>& F, const T& F33) const {
+    using std::log;
+    const T J = (F(0, 0) * F(1, 1) - F(0, 1) * F(1, 0)) * F33;
+    const T I1 = (F * F.transpose()).trace() + F33 * F33;
+    const T lnJ = log(J);
+    return T(0.5 * mu) * (I1 - T(3.0)) - T(mu) * lnJ + T(0.5 * lambda) * lnJ * lnJ;
   }
 
   // Small-strain P-wave modulus lambda + 2 mu.

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "tools/app/config.hpp"
+#include "tools/app/material_drive.hpp"
 #include "tools/app/mms_command.hpp"
 #include "tools/app/suite/suite.hpp"
 #include "tools/app/installation.hpp"
@@ -141,6 +142,27 @@ int main(int argc, char** argv) {
       ->allow_extra_args(false)
       ->type_name("KEY=VALUE");
 
+  CLI::App* material_cmd = app.add_subcommand(
+      "material", "The material-point driver: each material under F-tables, against its exact stress and energy.");
+  material_cmd->require_subcommand(1);
+  material_cmd->add_subcommand("tables", "The standard F-tables and the table file's format.");
+  mpmvv::app::MaterialDriveRequest drive;
+  CLI::App* drive_cmd = material_cmd->add_subcommand(
+      "drive", "Drive every material (or --material) through F-tables, unrotated and under a superimposed rotation, "
+               "and compare its stress and energy with the principal-stretch forms, its energy's derivative, the "
+               "work along the path and the rotated stress.\nExit status: 0 every check within tolerance, 1 some "
+               "check above, 2 bad input.");
+  drive_cmd->add_option("--material", drive.materials, "neo-hookean, mooney-rivlin or linear-elastic (repeatable)");
+  drive_cmd->add_option("--table", drive.tables, "a standard F-table (mpmvv material tables) or a table file (repeatable)");
+  drive_cmd->add_option("--rotation", drive.rotation_degrees, "superimposed rotation at the path's end [deg]; 0: none");
+  drive_cmd->add_option("--steps", drive.steps, "samples along a standard table's path")->check(CLI::Range(2, 1000000));
+  drive_cmd->add_option("--tolerance", drive.tolerance, "largest relative error a check allows")
+      ->check(CLI::PositiveNumber);
+  drive_cmd->add_option("--set", drive.overrides, "a material key: --set lambda=1e3 (repeatable; mpmvv run --describe)")
+      ->allow_extra_args(false)
+      ->type_name("KEY=VALUE");
+  drive_cmd->add_option("--json", drive.json, "also write the rows and the parameters as JSON to this file");
+
   if (argc > 1 && argv[1][0] != '-') {
     bool known = false;
     std::string commands;
@@ -176,6 +198,11 @@ int main(int argc, char** argv) {
     }
     if (eval_cmd->parsed()) return mpmvv::app::mms_eval(eval, std::cout, std::cerr);
     if (check_cmd->parsed()) return mpmvv::app::mms_check(check, std::cout, std::cerr);
+  }
+  if (material_cmd->parsed()) {
+    if (drive_cmd->parsed()) return mpmvv::app::material_drive(drive, std::cout, std::cerr);
+    std::cout << mpmvv::app::material_tables();
+    return 0;
   }
   if (suite_cmd->parsed()) return mpmvv::app::run_suite(suite, std::cout, std::cerr);
   if (report_cmd->parsed()) {
