@@ -19,6 +19,8 @@ returns a matplotlib Figure (Agg backend; no display needed):
   level, against an exact curve drawn as a line (the Hertz contact pressure);
 * histories: one line per case of a scalar against another recorded after
   every step (the Hertz load against approach);
+* log_curves: panels of curves on a logarithmic error axis, a marker at every
+  value (the ring's L1 over time and its marker refinement, ring_figures.py);
 (the run-health figure is health_plot.py's).
 """
 import math
@@ -315,6 +317,36 @@ def _line_panels(panels, title, x_label, y_label, markers):
                           textcoords="offset points", ha="left", va="top", fontsize=8, color="grey")
         if drawn:
             axes.legend(fontsize=8)
+        else:
+            _no_data(axes)
+        label_panel(axes, x_label, y_label, panel.title)
+    suptitle(figure, title)
+    return figure
+
+
+def log_curves(panels, title, x_label, y_label, log_x=False):
+    """panels: LinePanel; each curve drawn with a marker at every value and joined by
+    a thin line, the error axis logarithmic (non-positive values are left out)."""
+    figure, axes_list = _panel_grid(len(panels), width=5.6, height=4.4)
+    for axes, panel in zip(axes_list, panels):
+        drawn = False
+        for curve in panel.curves:
+            x, y = _finite_positive(curve.x, curve.y)
+            if not x:
+                continue
+            axes.plot(x, y, "-", marker=curve.style.marker, markersize=4, linewidth=0.9, color=curve.style.colour,
+                      label=curve.label)
+            drawn = True
+        if drawn:
+            axes.set_yscale("log")
+            if log_x:
+                # Ticks at the values drawn (particles per direction 2, 4, 8), as plain numbers.
+                axes.set_xscale("log")
+                ticks = sorted({a for c in panel.curves for a in _finite_positive(c.x, c.y)[0]})
+                axes.set_xticks(ticks, [f"{t:g}" for t in ticks])
+                axes.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+            plain_log_labels(axes)
+            axes.legend(fontsize=7)
         else:
             _no_data(axes)
         label_panel(axes, x_label, y_label, panel.title)

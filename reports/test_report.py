@@ -143,8 +143,8 @@ def test_gold_results_directory_renders_and_gates(tmp_path):
     assert gate.main([str(GOLD)]) in (0, 1)
 
 
-RING_FIGURES = ["ring-error-L1_theta0-end.png", "ring-error-particle_L2-end.png", "ring-history-point_R1.png",
-                "ring-profile-theta0.png", "ring-spectrum.png", "ring-stability.png", "ring-work-precision.png"]
+RING_FIGURES = ["ring-L1-over-time.png", "ring-error-L1_theta0-end.png", "ring-error-particle_L2-end.png",
+                "ring-history-point_R1.png", "ring-profile-theta0.png", "ring-spectrum.png", "ring-stability.png", "ring-work-precision.png"]
 
 
 def test_suite_without_contact_history_or_measurements_renders_as_before(synthetic_report):
