@@ -21,6 +21,8 @@ returns a matplotlib Figure (Agg backend; no display needed):
   every step (the Hertz load against approach);
 * log_curves: panels of curves on a logarithmic error axis, a marker at every
   value (the ring's L1 over time and its marker refinement, ring_figures.py);
+* particle_maps: the particles at chosen output times coloured by a field and,
+  below, by their displacement error (the maps of the Sandia report);
 (the run-health figure is health_plot.py's).
 """
 import math
@@ -350,6 +352,46 @@ def log_curves(panels, title, x_label, y_label, log_x=False):
         else:
             _no_data(axes)
         label_panel(axes, x_label, y_label, panel.title)
+    suptitle(figure, title)
+    return figure
+
+
+@dataclass
+class ParticleMap:
+    label: str                    # e.g. "t = 0.25 s"
+    position: np.ndarray          # N x 2 [m]
+    field: np.ndarray             # N, the top row's colour
+    error: np.ndarray = None      # N, the bottom row's colour; None: no exact motion
+
+
+def particle_maps(maps, title, field_label, error_label):
+    """One column per map: the particles at their current positions coloured by the
+    field (top) and by the error (bottom), one colour scale per row from 0 to the
+    row's largest value, so an anomaly stands out as it does in the data."""
+    rows = 2 if any(m.error is not None for m in maps) else 1
+    figure, axes = plt.subplots(rows, len(maps), figsize=(max(3.6 * len(maps), 7.0), 3.4 * rows + 0.8),
+                                squeeze=False, constrained_layout=True)
+    for row, (values, label) in enumerate([("field", field_label), ("error", error_label)][:rows]):
+        arrays = [getattr(m, values) for m in maps]
+        top = max((float(np.nanmax(a)) for a in arrays if a is not None and a.size), default=1.0) or 1.0
+        drawn = None
+        for axes_k, m, a in zip(axes[row], maps, arrays):
+            if a is None:
+                _no_data(axes_k)
+                continue
+            # A marker about as large as a particle's share of its bounding box
+            # (a panel is about 3 inches, 216 points, across), so the body reads filled.
+            span = np.ptp(m.position, axis=0)
+            points_per_m = 216.0 / max(float(span.max()), 1e-300)
+            size = float(np.clip(0.7 * points_per_m ** 2 * span[0] * span[1] / max(len(a), 1), 0.05, 30.0))
+            drawn = axes_k.scatter(m.position[:, 0], m.position[:, 1], c=a, s=size, vmin=0.0, vmax=top,
+                                   cmap="viridis", linewidths=0)
+            axes_k.set_aspect("equal")
+            axes_k.set_title(m.label, fontsize=10)
+            axes_k.set_xlabel("x [m]")
+            axes_k.set_ylabel("y [m]")
+        if drawn is not None:
+            figure.colorbar(drawn, ax=list(axes[row]), shrink=0.85, label=label)
     suptitle(figure, title)
     return figure
 

@@ -9,7 +9,7 @@ from . import norms
 from .figure_parts import FigureEntry, saved, sort_value, split_label, time_text
 from .report_rows import error_columns, line_quantities, series_end_time, study_series
 from .results import lookup_error
-from .ring_figures import l1_over_time_figure, marker_refinement_figure
+from .ring_figures import l1_over_time_figure, marker_refinement_figure, particle_map_figure
 from .scene_figures import (contact_pressure_figure, health_figure, history_figure, load_approach_figure, profile_figure,
                            spectrum_figure)
 from .series import floor_text, size_name
@@ -154,6 +154,7 @@ def study_figures(suite, study, rows, directory):
         add(work_precision_figure, study, all_series, norm, norms.norm_unit(norm, quantities), styles, directory)
         add(marker_refinement_figure, study, suite, norm, pairs[0][1], quantities, directory)
     add(l1_over_time_figure, study, all_series, styles, quantities, directory)
+    add(particle_map_figure, study, all_series, directory)
     add(stability_figure, study, all_series, directory)
     add(health_figure, study, all_series, directory)
     add(profile_figure, study, all_series, directory)

@@ -273,3 +273,33 @@ def lookup_error(case, norm, time):
     if not math.isfinite(value):
         return nan, f"{norm} is {value} at t = {time:g}"
     return value, ""
+
+
+@dataclass(frozen=True)
+class ParticleSnapshot:
+    """One /snapshots/<k> group (particle_fields = "outputs"): the particles at an output time."""
+    time: float
+    position: np.ndarray            # N x 2 [m]
+    velocity: np.ndarray            # N x 2 [m/s]
+    displacement_error: np.ndarray  # N x 2 [m], x - x_exact(X, t); None without an exact motion
+
+
+def read_snapshot_times(path):
+    """The output times the file holds particle snapshots at, in order (empty without /snapshots)."""
+    with h5py.File(path, "r") as f:
+        group = f.get("snapshots")
+        if not isinstance(group, h5py.Group):
+            return []
+        return sorted((float(g.attrs["time"]), name) for name, g in group.items() if "time" in g.attrs)
+
+
+def read_snapshot(path, name, largest=None):
+    """The snapshot /snapshots/<name>; with `largest`, every k-th particle so that at
+    most that many are read (a figure needs no more)."""
+    with h5py.File(path, "r") as f:
+        g = f["snapshots"][name]
+        n = g["position"].shape[0]
+        stride = max(1, -(-n // largest)) if largest else 1
+        error = g["displacement_error"][::stride] if "displacement_error" in g else None
+        return ParticleSnapshot(float(g.attrs["time"]), g["position"][::stride], g["velocity"][::stride],
+                                None if error is None else np.asarray(error))

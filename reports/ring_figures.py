@@ -3,15 +3,17 @@
 curve per mesh (its figures 3.6, 3.8 and 3.9), and the marker refinement at a
 fixed mesh, the error against particles per direction with one curve per cell
 count (its figure 3.6(b): "no convergence ... as we increase the number of
-markers per linear direction"). Drawn wherever the results files hold the data:
-L1_<line> columns at three or more output times, or a study that sweeps both
-cells and particles_per_direction."""
+markers per linear direction"), and maps of the particles at chosen times
+coloured by speed and by their error (its figures 3.1, 3.2, 3.7, 3.10). Drawn
+wherever the results files hold the data: L1_<line> columns at three or more
+output times, a study that sweeps both cells and particles_per_direction, or
+particle snapshots (particle_fields = "outputs")."""
 import numpy as np
 
 from . import figures
 from . import norms
 from .figure_parts import FigureEntry, saved, sort_value
-from .results import lookup_error
+from .results import lookup_error, read_snapshot, read_snapshot_times
 
 LARGEST_CURVES = 12    # more cases than this: each series' coarsest and finest with results
 LINES_DRAWN = 4
@@ -112,3 +114,46 @@ def marker_refinement_figure(study, suite, norm, time, quantities, directory):
                                     f"per direction, one curve per mesh (cf. figure 3.6(b) of "
                                     f"000_1dbcb8acb6dddab9.txt); a case without a usable value at that time (stopped "
                                     f"or lost) leaves its point out.")
+
+
+MAPS_DRAWN = 4
+MAP_PARTICLES = 200_000
+
+
+def _spread(items, count):
+    """At most `count` of the items, evenly spread and including the last."""
+    if len(items) <= count:
+        return items
+    return [items[round(k * (len(items) - 1) / (count - 1))] for k in range(count)]
+
+
+def particle_map_figure(study, all_series, directory):
+    """The particles of the finest completed case with snapshots (particle_fields =
+    "outputs"; else the finest with snapshots): speed and displacement error at up
+    to four output times."""
+    found = [(s, c) for s in all_series for c in s.cases if c.results is not None
+             and read_snapshot_times(c.results_path)]
+    if not found:
+        return None
+    def finest_completed_first(pair):
+        h = pair[1].h
+        return pair[1].completed, -h if np.isfinite(h) else -np.inf
+    series, case = max(found, key=finest_completed_first)
+    times = _spread(read_snapshot_times(case.results_path), MAPS_DRAWN)
+    maps = []
+    for t, name in times:
+        snapshot = read_snapshot(case.results_path, name, MAP_PARTICLES)
+        error = (None if snapshot.displacement_error is None
+                 else np.linalg.norm(snapshot.displacement_error, axis=1))
+        maps.append(figures.ParticleMap(f"t = {t:g} s", snapshot.position, np.linalg.norm(snapshot.velocity, axis=1),
+                                        error))
+    level = f"{series.refine}={case.keys[series.refine]}"
+    figure = figures.particle_maps(maps, f"{study}: particles of {series.label}, {level}", "speed |v| [m/s]",
+                                   "displacement error |x - x_exact| [m]")
+    path = saved(figure, directory, study, 'particle-maps')
+    stopped = "" if case.completed else f" (this run {case.status} at t = {case.time_reached:.3g} s)"
+    return FigureEntry(study, path, f"{study}: the particles of {series.label}, {level}{stopped}, at their current "
+                                    f"positions at {len(maps)} of its output times, coloured by speed (top, as "
+                                    f"figures 3.7 and 3.10 of 000_1dbcb8acb6dddab9.txt) and by the magnitude of "
+                                    f"their displacement error (bottom), each row on one scale from 0 to its largest "
+                                    f"value (at most {MAP_PARTICLES} particles drawn, every k-th).")

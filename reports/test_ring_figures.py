@@ -1,5 +1,7 @@
 """The ring's figures in the Sandia report's manner (ring_figures.py): L1 over
 time per case, and the marker refinement at fixed mesh."""
+import h5py
+import numpy as np
 import pytest
 
 from . import figures
@@ -82,3 +84,33 @@ def test_no_ring_figures_without_their_data(tmp_path, monkeypatch):
     directory = write_suite_directory(tmp_path / "suite", SYNTHETIC_SUITE, cases)
     report.main([str(directory), "-o", str(tmp_path / "out")])
     assert calls == {}
+
+
+def add_snapshots(path, times, n=50):
+    """/snapshots/<k> as particle_fields = "outputs" writes them: velocity (k + 1) e_x and
+    displacement error 0.001 k e_y on n particles."""
+    with h5py.File(path, "a") as f:
+        for k, t in enumerate(times):
+            g = f.create_group(f"snapshots/{k}")
+            g.attrs["time"] = t
+            g["position"] = np.stack([np.linspace(0.75, 1.25, n), np.zeros(n)], axis=1)
+            g["velocity"] = np.tile([k + 1.0, 0.0], (n, 1))
+            g["displacement_error"] = np.tile([0.0, 0.001 * k], (n, 1))
+
+
+def test_particle_maps_of_the_finest_completed_case_at_spread_times(tmp_path, monkeypatch):
+    """Requirement: the finest completed case with /snapshots is drawn at up to four of
+    its output times, spread over them and ending at the last, coloured by speed and by
+    the magnitude of the displacement error."""
+    calls = record_calls(monkeypatch, figures, "particle_maps")
+    directory = write_suite_directory(tmp_path / "suite", SYNTHETIC_SUITE, synthetic_ring_cases())
+    times = [0.1, 0.2, 0.3, 0.4, 0.5, 0.6]
+    for cells in (32, 64, 128):          # cpdi 128 is the finest completed; linear 256 too, but on its own series
+        add_snapshots(directory / "cases" / f"ring-method=cpdi-cells={cells}.h5", times)
+    report.main([str(directory), "-o", str(tmp_path / "out")])
+    (maps,) = calls.values()
+    assert list(calls) == ["ring: particles of method=cpdi, cells=128"]
+    assert [m.label for m in maps] == ["t = 0.1 s", "t = 0.3 s", "t = 0.4 s", "t = 0.6 s"]
+    assert [float(m.field[0]) for m in maps] == [1.0, 3.0, 4.0, 6.0]
+    assert [float(m.error[0]) for m in maps] == pytest.approx([0.0, 0.002, 0.003, 0.005])
+    assert (tmp_path / "out" / "figures" / "ring-particle-maps.png").is_file()
