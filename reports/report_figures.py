@@ -153,7 +153,7 @@ def study_figures(suite, study, rows, directory):
         norm = pairs[0][0]
         add(work_precision_figure, study, all_series, norm, norms.norm_unit(norm, quantities), styles, directory)
         add(marker_refinement_figure, study, suite, norm, pairs[0][1], quantities, directory)
-    add(l1_over_time_figure, study, all_series, styles, quantities, directory)
+    add(l1_over_time_figure, study, all_series, quantities, directory)
     add(particle_map_figure, study, all_series, directory)
     add(stability_figure, study, all_series, directory)
     add(health_figure, study, all_series, directory)

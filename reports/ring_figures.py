@@ -49,7 +49,7 @@ def _case_label(series, case):
     return label if case.completed else label + f" ({case.status} at t = {case.time_reached:.3g} s)"
 
 
-def l1_over_time_figure(study, all_series, styles, quantities, directory):
+def l1_over_time_figure(study, all_series, quantities, directory):
     chosen = _curve_cases(all_series)
     lines = [n for n in dict.fromkeys(n for _, c in chosen for n in c.results.errors) if n.startswith("L1_")]
     if not chosen or not lines:
@@ -60,8 +60,11 @@ def l1_over_time_figure(study, all_series, styles, quantities, directory):
         for series, case in chosen:
             if line not in case.results.errors:
                 continue
+            # Colour: the series (its own, not its method's: two amplitudes of one
+            # method must not look alike); marker: the level.
             level = list(series.cases).index(case)
-            style = figures.Style(styles[series.label].colour, figures.MARKERS[level % len(figures.MARKERS)])
+            style = figures.Style(figures.COLOURS[all_series.index(series) % len(figures.COLOURS)],
+                                  figures.MARKERS[level % len(figures.MARKERS)])
             curves.append(figures.Curve(_case_label(series, case), case.results.error_times,
                                         _solution_until_lost(case, case.results.errors[line]), style))
         panels.append(figures.LinePanel(line, curves))
@@ -70,13 +73,16 @@ def l1_over_time_figure(study, all_series, styles, quantities, directory):
                                 f"L1 [{unit}]")
     path = saved(figure, directory, study, 'L1-over-time')
     left = " (" + ", ".join(lines[LINES_DRAWN:]) + " not drawn)" if len(lines) > LINES_DRAWN else ""
+    silent = [_case_label(s, c) for s in all_series for c in s.cases
+              if c.results is not None and not c.results.error_times.size]
+    silent = f" No output before it stopped, so no curve: {'; '.join(silent)}." if silent else ""
     meaning = norms.describe_norm(lines[0], quantities)
     return FigureEntry(study, path, f"{study}: L1 of each probe line{left} at every output time ({lines[0]}: "
                                     f"{meaning}; the others alike), one curve per case "
                                     f"(colour: series, marker: level; with more than {LARGEST_CURVES} cases each "
                                     f"series' coarsest and finest), as figures 3.6, 3.8 and 3.9 of "
                                     f"000_1dbcb8acb6dddab9.txt draw it; a curve ends where its run stopped or its "
-                                    f"solution was found lost.")
+                                    f"solution was found lost.{silent}")
 
 
 def marker_refinement_figure(study, suite, norm, time, quantities, directory):
@@ -89,7 +95,7 @@ def marker_refinement_figure(study, suite, norm, time, quantities, directory):
     for case in cases:
         problem = ", ".join(f"{k}={case.keys[k]}" for k in others if k in case.keys) or study
         panels.setdefault(problem, {}).setdefault(case.keys["cells"], []).append(case)
-    drawn = []
+    drawn, empty = [], []
     for problem, by_cells in panels.items():
         curves = []
         for i, cells in enumerate(sorted(by_cells, key=sort_value)):
@@ -101,8 +107,10 @@ def marker_refinement_figure(study, suite, norm, time, quantities, directory):
                                         [lookup_error(c, norm, when(c))[0] for c in own],
                                         figures.Style(figures.COLOURS[i % len(figures.COLOURS)],
                                                       figures.MARKERS[i % len(figures.MARKERS)])))
-        if curves:
+        if any(np.isfinite(y) for c in curves for y in c.y):
             drawn.append(figures.LinePanel(problem, curves))
+        elif curves:
+            empty.append(problem)
     if not drawn:
         return None
     unit = norms.norm_unit(norm, quantities)
@@ -113,7 +121,8 @@ def marker_refinement_figure(study, suite, norm, time, quantities, directory):
     return FigureEntry(study, path, f"{study}: {norms.describe_norm(norm, quantities)} at {when} against particles "
                                     f"per direction, one curve per mesh (cf. figure 3.6(b) of "
                                     f"000_1dbcb8acb6dddab9.txt); a case without a usable value at that time (stopped "
-                                    f"or lost) leaves its point out.")
+                                    f"or lost) leaves its point out."
+                                    + (f" No usable value at all, so no panel: {'; '.join(empty)}." if empty else ""))
 
 
 MAPS_DRAWN = 4
