@@ -99,7 +99,13 @@ NewtonKrylovResult solve_newton_krylov(const NewtonKrylovProblem& problem, std::
   check(KINSetMaxNewtonStep(kinsol.get(), 1e3 * std::sqrt(double(n))), "KINSetMaxNewtonStep");
   const int flag = KINSol(kinsol.get(), x.get(), KIN_LINESEARCH, u_scale.get(), f_scale.get());
   r.converged = flag >= 0;
-  if (!r.converged) {
+  // KINGetReturnFlagName names these two NONE; they say where the residual
+  // could not be evaluated (a particle turned inside out, a non-finite force).
+  if (flag == KIN_FIRST_SYSFUNC_ERR) {
+    r.message = "the residual is not finite at the initial guess (KIN_FIRST_SYSFUNC_ERR, flag -14)";
+  } else if (flag == KIN_REPTD_SYSFUNC_ERR) {
+    r.message = "the residual was not finite at the trial points of repeated steps (KIN_REPTD_SYSFUNC_ERR, flag -15)";
+  } else if (!r.converged) {
     char* name = KINGetReturnFlagName(flag);
     r.message = std::string(name ? name : "KINSol failed") + " (flag " + std::to_string(flag) + ")";
     free(name);
