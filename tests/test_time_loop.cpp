@@ -1,7 +1,7 @@
 // The time loop (solver/time_loop.hpp) around the explicit step: failures
 // reported as data, output times landed on within the CFL step, a step
 // prepared by its map, a stage that gives up, a run stopped by a signal and
-// resumed; and the memory a stepper reports per particle.
+// resumed.
 #include <gtest/gtest.h>
 
 #include "solver_models.hpp"
@@ -279,42 +279,6 @@ TEST(TimeLoop, AStepPreparedByItsMapScansAndMovesAsOneThatMapsItself) {
     EXPECT_EQ(infinite->scan().first_unhealthy, 12u);
     EXPECT_EQ(infinite->prepare_step(0.0).first_unhealthy, 12u);
   }
-}
-
-// The memory a run holds per particle (Stepper::bytes_per_particle, the
-// throughput benchmark's bytes column): linear MPM's eight arrays, x, v, F,
-// V, sigma, m, V0 and X (16 + 16 + 32 + 8 + 32 + 8 + 8 + 16 = 136 bytes); GIMP
-// adds its half sizes (16); MUSL's stepper its next positions (16).
-TEST(Stepper, BytesPerParticleCountEveryArrayItHolds) {
-  auto linear = mpmvv::make_stepper(disk_model(Method::linear), SolverOptions{Method::linear, Scheme::usl},
-                                    MaterialModel{kSolid}, nullptr);
-  EXPECT_EQ(linear->bytes_per_particle(), 136.0);
-  auto gimp = mpmvv::make_stepper(disk_model(Method::gimp), SolverOptions{Method::gimp, Scheme::usl},
-                                  MaterialModel{kSolid}, nullptr);
-  EXPECT_EQ(gimp->bytes_per_particle(), 152.0);
-  auto musl = mpmvv::make_stepper(disk_model(Method::gimp), SolverOptions{Method::gimp, Scheme::musl},
-                                  MaterialModel{kSolid}, nullptr);
-  EXPECT_EQ(musl->bytes_per_particle(), 168.0);
-}
-
-// A body force's own arrays count too (BodyForce::bytes): here 40 bytes a
-// particle beside linear MPM's 136 and the body-force array b_p (16).
-class KeepingBodyForce final : public mpmvv::BodyForce {
- public:
-  void prepare(const Particles& P) override { kept_.assign(5 * P.size(), 0.0); }
-  void evaluate(double, const Particles&, std::vector<Vec2>& b) const override {
-    for (Vec2& v : b) v.setZero();
-  }
-  std::size_t bytes() const override { return mpmvv::bytes_held(kept_); }
-
- private:
-  std::vector<double> kept_;
-};
-
-TEST(Stepper, BytesPerParticleCountWhatTheBodyForceKeeps) {
-  auto stepper = mpmvv::make_stepper(disk_model(Method::linear), SolverOptions{Method::linear, Scheme::usl},
-                                     MaterialModel{kSolid}, std::make_shared<KeepingBodyForce>());
-  EXPECT_EQ(stepper->bytes_per_particle(), 136.0 + 16.0 + 40.0);
 }
 
 // A stepper whose stage gives up at its third step, as a system of rest
