@@ -19,14 +19,6 @@ LARGEST_CURVES = 12    # more cases than this: each series' coarsest and finest 
 LINES_DRAWN = 4
 
 
-def _solution_until_lost(case, values):
-    """The column's values, NaN from the output time the health verdict found the solution lost."""
-    values = np.array(values, float)
-    if case.attribute("health", "") == "solution lost":
-        values[case.results.error_times >= float(case.attribute("health_time"))] = np.nan
-    return values
-
-
 def _curve_cases(all_series):
     """Every case with results, when some case has three or more output times (a
     failed run's curve is as short as the outputs it made)."""
@@ -65,8 +57,10 @@ def l1_over_time_figure(study, all_series, quantities, directory):
             level = list(series.cases).index(case)
             style = figures.Style(figures.COLOURS[all_series.index(series) % len(figures.COLOURS)],
                                   figures.MARKERS[level % len(figures.MARKERS)])
-            curves.append(figures.Curve(_case_label(series, case), case.results.error_times,
-                                        _solution_until_lost(case, case.results.errors[line]), style))
+            # lookup_error's rule: no value from the time the solution was found lost.
+            times = case.results.error_times
+            curves.append(figures.Curve(_case_label(series, case), times,
+                                        [lookup_error(case, line, t)[0] for t in times], style))
         panels.append(figures.LinePanel(line, curves))
     unit = norms.norm_unit(lines[0], quantities)
     figure = figures.log_curves(panels, f"{study}: L1 of each probe line over time", "time t [s]",
@@ -140,15 +134,16 @@ def particle_map_figure(study, all_series, directory):
     """The particles of the finest completed case with snapshots (particle_fields =
     "outputs"; else the finest with snapshots): speed and displacement error at up
     to four output times."""
-    found = [(s, c) for s in all_series for c in s.cases if c.results is not None
-             and read_snapshot_times(c.results_path)]
+    found = [(s, c, t) for s in all_series for c in s.cases if c.results is not None
+             for t in [read_snapshot_times(c.results_path)] if t]
     if not found:
         return None
-    def finest_completed_first(pair):
-        h = pair[1].h
-        return pair[1].completed, -h if np.isfinite(h) else -np.inf
-    series, case = max(found, key=finest_completed_first)
-    times = _spread(read_snapshot_times(case.results_path), MAPS_DRAWN)
+
+    def finest_completed_first(entry):
+        h = entry[1].h
+        return entry[1].completed, -h if np.isfinite(h) else -np.inf
+    series, case, all_times = max(found, key=finest_completed_first)
+    times = _spread(all_times, MAPS_DRAWN)
     maps = []
     for t, name in times:
         snapshot = read_snapshot(case.results_path, name, MAP_PARTICLES)

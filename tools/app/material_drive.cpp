@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "analytic/f_tables.hpp"
 #include "analytic/principal_stress.hpp"
@@ -23,7 +24,6 @@ namespace {
 
 using analytic::Deformation;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-const std::vector<std::string> kMaterials = {"neo-hookean", "mooney-rivlin", "linear-elastic"};
 
 // A path of homogeneous states, s from 0 to 1.
 struct Path {
@@ -289,10 +289,15 @@ int material_drive(const MaterialDriveRequest& request, std::ostream& out, std::
     if (!std::isfinite(request.rotation_degrees))
       throw ConfigError("--rotation: not a finite angle");
     config = material_config(request.overrides);
-    const std::vector<std::string> materials = request.materials.empty() ? kMaterials : request.materials;
+    // The materials the `material` key declares (scene/setup.cpp: material_keys).
+    const std::vector<std::string>& known =
+        std::find_if(config.specs().begin(), config.specs().end(), [](const KeySpec& k) {
+          return k.name == "material";
+        })->choices;
+    const std::vector<std::string> materials = request.materials.empty() ? known : request.materials;
     for (const std::string& m : materials)
-      if (std::find(kMaterials.begin(), kMaterials.end(), m) == kMaterials.end())
-        throw ConfigError(fmt::format("--material '{}': unknown (known: neo-hookean, mooney-rivlin, linear-elastic)", m));
+      if (std::find(known.begin(), known.end(), m) == known.end())
+        throw ConfigError(fmt::format("--material '{}': unknown (known: {})", m, fmt::join(known, ", ")));
     std::vector<std::string> tables = request.tables;
     if (tables.empty())
       for (const analytic::FTable& t : analytic::standard_f_tables()) tables.push_back(t.name);

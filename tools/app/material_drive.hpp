@@ -26,7 +26,7 @@ struct MaterialDriveRequest {
   std::vector<std::string> tables;     // names of standard tables or table files; empty: every standard table
   double rotation_degrees = 90.0;      // the superimposed rotation's end angle; 0: unrotated rows only
   int steps = 1000;                    // samples along a standard table's path (the work check is
-                                       // fourth order in them: 3e-13 at 1000)
+                                       // fourth order in them: at most 5e-13 at 1000)
   double tolerance = 1e-10;            // largest relative error a check allows
   std::vector<std::string> overrides;  // material keys: lambda=..., c2=...
   std::string json;                    // write the rows here too
