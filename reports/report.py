@@ -9,6 +9,8 @@ Writes
   OUT/orders.csv    one row per (study, refinement series, error norm, output time)
   OUT/levels.csv    one row per level of each of those rows
   OUT/gci.csv       Richardson extrapolation and GCI of each series' point-probe value
+  OUT/summary.json  every case's state, the gate's verdicts and orders.csv's rows in one file
+                    (summary_file.py)
 
 The columns of orders.csv and levels.csv are ORDERS_CSV_COLUMNS and LEVELS_CSV_COLUMNS
 (report_rows.py); the report states them.
@@ -33,6 +35,7 @@ from .report_tables import (case_table, expectation_table, gci_table, measuremen
                            reference_sections, write_gci_csv, write_levels_csv,
                            write_orders_csv)
 from .results import SuiteDirectoryError, read_suite
+from .summary_file import write_summary
 
 
 @dataclass(frozen=True)
@@ -45,6 +48,8 @@ class Report:
     gci_rows: list
     sections: list               # (title, paragraph, Table or None)
     figures: list                # FigureEntry
+    verdicts: list = None        # the gate's, when the suite has expectations and they could be checked
+    gate_error: str = ""         # why they could not be
 
 
 def status_counts(suite):
@@ -76,12 +81,14 @@ def build_report(suite, figure_directory):
     rows, grid_rows = order_rows(suite), gci_rows(suite)
     sections = [("Cases", "Status from manifest.json; time reached, failure reason, wall time of the time loop, "
                  "steps and particle count from each results file.", case_table(suite))]
+    verdicts, gate_error = None, ""
     if suite.expectations:
         try:
             verdicts = gate.gate(suite)
             summary = gate.summary_line(verdicts, len(suite.expectations))
             sections.append(("Expectations", f"As checked by mpmvv gate: {summary}.", expectation_table(verdicts)))
         except SuiteDirectoryError as error:
+            gate_error = str(error)
             sections.append(("Expectations", f"Not checked: {error}", None))
     sections += reference_sections(suite, rows)
     sections += measurement_sections(suite)
@@ -101,7 +108,7 @@ def build_report(suite, figure_directory):
                      "angle), which rounding alone can explain: no order, extrapolation or GCI.", gci_table(grid_rows)))
     entries = [e for study in suite.study_names() for e in study_figures(suite, study, rows, figure_directory)]
     return Report(suite, datetime.now(), status_counts(suite), stored_norm_check(suite), rows, grid_rows,
-                  sections, entries)
+                  sections, entries, verdicts, gate_error)
 
 
 def header_lines(report):
@@ -200,12 +207,14 @@ def write_report(directory, output=None):
         old.unlink()
     report = build_report(suite, figure_directory)
     written = {"html": output / "report.html", "markdown": output / "report.md",
-               "orders": output / "orders.csv", "levels": output / "levels.csv", "gci": output / "gci.csv"}
+               "orders": output / "orders.csv", "levels": output / "levels.csv", "gci": output / "gci.csv",
+               "summary": output / "summary.json"}
     written["html"].write_text(render_html(report))
     written["markdown"].write_text(render_markdown(report, output))
     write_orders_csv(report.order_rows, written["orders"])
     write_levels_csv(report.order_rows, written["levels"])
     write_gci_csv(report.gci_rows, written["gci"])
+    write_summary(written["summary"], report)
     return written, sum(e.path is not None for e in report.figures)
 
 

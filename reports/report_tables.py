@@ -160,18 +160,21 @@ def _per_level(row, value):
     return [float("nan") if c is None else value(c) for c in row.roundoff]
 
 
+def order_row_values(r):
+    """One row of orders.csv, in the order of ORDERS_CSV_COLUMNS (summary.json takes the same values)."""
+    finest = r.levels[-1] if r.levels else None
+    return [r.study, r.series.label, r.norm, r.unit, repr(r.time), r.series.refine, len(r.levels), len(r.left_out),
+            *(repr(v if r.has_order else float("nan")) for v in (r.fit.order, r.fit.ci_low, r.fit.ci_high)),
+            r.classification, finest.value if finest else "", repr(finest.h) if finest else "",
+            repr(finest.error) if finest else ""]
+
+
 def write_orders_csv(rows, path):
     with open(path, "w", newline="") as stream:
         writer = csv.writer(stream)
         writer.writerow([name for name, _ in ORDERS_CSV_COLUMNS])
         for r in rows:
-            finest = r.levels[-1] if r.levels else None
-            writer.writerow([r.study, r.series.label, r.norm, r.unit, repr(r.time), r.series.refine,
-                             len(r.levels), len(r.left_out),
-                             *(repr(v if r.has_order else float("nan")) for v in (r.fit.order, r.fit.ci_low,
-                                                                                   r.fit.ci_high)),
-                             r.classification, finest.value if finest else "", repr(finest.h) if finest else "",
-                             repr(finest.error) if finest else ""])
+            writer.writerow(order_row_values(r))
 
 
 def write_levels_csv(rows, path):

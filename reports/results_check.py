@@ -127,8 +127,10 @@ def check_probes(f, problems):
     if "probes" not in f:
         problems.append("/probes: missing")
         return
-    check_table(f, "probes/monitors", problems, required=("kinetic_energy", "strain_energy", "energy_created",
-                                                          "min_J", "max_J"))
+    # An external program's run has no monitors: mpmvv does not see its energies (/external).
+    if "external" not in f:
+        check_table(f, "probes/monitors", problems, required=("kinetic_energy", "strain_energy", "energy_created",
+                                                              "min_J", "max_J"))
     for name, group in f["probes"].items():
         # The scene groups without a quantity the format documents.
         if name in ("monitors", "contact_pressure", "history", "axis_stress") or not isinstance(group, h5py.Group):
@@ -162,6 +164,21 @@ def check_errors(f, problems):
             problems.append(f"/errors/time: a completed run's last output time {time[-1]:g} is not end_time {end:g}")
 
 
+def check_external(f, problems):
+    """An external program's run (reports/external-format.md): what ran and how it ended."""
+    if "external" not in f:
+        return
+    group = f["external"]
+    for name in ("command", "command_template", "format", "ended", "exit_status", "fields", "J_rule"):
+        if name not in group.attrs:
+            problems.append(f"/external/@{name}: missing")
+    if "output_time" not in group:
+        problems.append("/external/output_time: missing")
+    elif "errors" in f and "time" in f["errors"] and group["output_time"].shape != f["errors"]["time"].shape:
+        problems.append(f"/external/output_time: {group['output_time'].shape[0]} rows, /errors/time has "
+                        f"{f['errors']['time'].shape[0]}")
+
+
 def check_file(path):
     """The problems of one results file (empty when it follows the format); raises OSError if unreadable."""
     problems = []
@@ -170,6 +187,7 @@ def check_file(path):
         check_particles(f, problems)
         check_errors(f, problems)
         check_probes(f, problems)
+        check_external(f, problems)
     return problems
 
 

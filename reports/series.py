@@ -34,8 +34,11 @@ class Series:
 
     @property
     def label(self):
-        """The keys that tell the series apart; for a lone series, its method when it has one."""
+        """The keys that tell the series apart; for a lone series, its method when it has one (an
+        external program's cases: "external program", whose method is its own, not the key's)."""
         keys = self.label_keys
+        if not keys and self.cases and self.cases[0].keys.get("external_command"):
+            return "external program"
         if not keys and self.cases and "method" in self.cases[0].keys:
             keys = {"method": self.cases[0].keys["method"]}
         return ", ".join(f"{key}={value}" for key, value in keys.items()) or "all cases"

@@ -210,6 +210,8 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
       fmt::print(err, "mpmvv run: the suite that started this case (process {}) has ended\n", parent);
       return 2;
     }
+    // Not for the programs this run starts (an external_command may be mpmvv itself).
+    ::unsetenv(kSuiteParent);
   }
   std::unique_ptr<SceneCase> scene;
   Config config("", {});
@@ -221,6 +223,7 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
     if (output.empty()) output = fs::path(request.scene_file).stem().string() + ".h5";
     fault = injected_fault(output);
     scene->inject(fault);
+    scene->set_results_path(output);
     if (fs::path(output).extension() != ".h5")
       throw ConfigError(fmt::format("-o {}: the results file must end in .h5", output));
     const fs::path parent = fs::absolute(output).parent_path();
@@ -292,13 +295,17 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
     fmt::print(err, "mpmvv run: writing {} failed: {}\n", output, e.what());
     return 2;
   }
-  // The ParaView sidecar, from the file as written; the results stand without it.
-  try {
-    write_xdmf_sidecar(output);
-  } catch (const std::exception& e) {
-    fmt::print(err, "mpmvv run: {} is written; its ParaView sidecar {} is not: {}\n", output,
-               xdmf_sidecar_path(output), e.what());
+  // The ParaView sidecar, from the file as written; the results stand without
+  // it (an external program's run that wrote no output has no particles to show).
+  if (scene->particle_count() > 0) {
+    try {
+      write_xdmf_sidecar(output);
+    } catch (const std::exception& e) {
+      fmt::print(err, "mpmvv run: {} is written; its ParaView sidecar {} is not: {}\n", output,
+                 xdmf_sidecar_path(output), e.what());
+    }
   }
+
 
   const double rate = o.wall_seconds > 0 ? double(o.particle_steps) / o.wall_seconds : 0.0;
   const std::string place =
@@ -306,19 +313,24 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
           ? fmt::format(", at the particle from ({:.4g}, {:.4g})", health.reference_position->x(),
                         health.reference_position->y())
           : std::string();
+  // Who ran it: mpmvv's method, or the external program.
+  const std::string method = scene->external() ? std::string("(external program)") : config.text("method");
   if (o.completed && health.lost)
     fmt::print(out, "{} {}: SOLUTION LOST (status \"lost\"): it ran to t = {:.4g} s in {} steps, but at t = {:.4g} s {}{}\n",
-               config.scene(), config.text("method"), o.time_reached, o.steps, health.time, health.reason, place);
+               config.scene(), method, o.time_reached, o.steps, health.time, health.reason, place);
+  else if (o.completed && scene->external())
+    fmt::print(out, "{} {}: completed t = {:.4g} s, {:.3g} s wall, {} particles at the end, h = {:.4g} m\n",
+               config.scene(), method, o.time_reached, o.wall_seconds, scene->particle_count(), scene->cell_size());
   else if (o.completed)
     fmt::print(out, "{} {}: completed t = {:.4g} s in {} steps, {:.3g} s wall ({:.3g} s forcing), {} particles, h = {:.4g} m, {:.3g} particle-steps/s\n",
                config.scene(), config.text("method"), o.time_reached, o.steps, o.wall_seconds, o.forcing_seconds,
                scene->particle_count(), scene->cell_size(), rate);
   else if (o.failure_reason == kInterrupted)
     fmt::print(out, "{} {}: INTERRUPTED at t = {:.4g} s, step {}: what it computed is written (status \"interrupted\")\n",
-               config.scene(), config.text("method"), o.failure_time, o.failure_step);
+               config.scene(), method, o.failure_time, o.failure_step);
   else
-    fmt::print(out, "{} {}: FAILED at t = {:.4g} s, step {}{}: {} ({})\n", config.scene(), config.text("method"),
-               o.failure_time, o.failure_step,
+    fmt::print(out, "{} {}: FAILED at t = {:.4g} s{}{}: {} ({})\n", config.scene(), method, o.failure_time,
+               scene->external() ? std::string() : fmt::format(", step {}", o.failure_step),
                o.failure_particle >= 0 ? fmt::format(", particle {}", o.failure_particle) : std::string(),
                o.failure_reason, o.failure_detail);
   if (!o.completed && health.lost && o.failure_reason != kInterrupted)

@@ -10,6 +10,7 @@
 
 #include <fmt/format.h>
 
+#include "external_case.hpp"
 #include "monitor_log.hpp"
 #include "norms.hpp"
 #include "probes.hpp"
@@ -245,7 +246,8 @@ class Case final : public SceneCase, private RunObserver {
                         config_.real("energy_blowup_factor"));
     errors_.time.push_back(t);
     if (config_.text("particle_fields") == "outputs")
-      snapshots_.record(t, s.model().particles, setup_.exact_motion ? setup_.solution.get() : nullptr);
+      snapshots_.record(t, s.model().particles, setup_.exact_motion ? setup_.solution.get() : nullptr,
+                        s.model().tracers);
     const std::vector<double> line_l1 = probes_.at_output(t, s.model().tracers);
     for (std::size_t k = 0; k < line_l1.size(); ++k) errors_.columns[k].second.push_back(line_l1[k]);
     // Volume-weighted errors over all particles (norms.hpp).
@@ -289,6 +291,8 @@ class Case final : public SceneCase, private RunObserver {
 }  // namespace
 
 std::unique_ptr<SceneCase> SceneType::build(const Config& config) const {
+  if (const std::optional<ExternalProgram> program = external_program(config))
+    return make_external_case(config, *this, *program);
   return std::make_unique<Case>(config, *this);
 }
 

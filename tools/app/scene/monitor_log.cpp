@@ -44,28 +44,35 @@ void MonitorLog::record(double t, const Stepper& s, int stable_step_iterations, 
                          t, created, created / largest_energy_, largest_energy_, blowup_factor)};
 }
 
-// A ratio that is not a number (a NaN J) counts as farthest of all.
-void MonitorLog::record_J_ratio(const Particles& P) {
-  Row& row = rows_.back();
-  row.min_J_ratio = std::numeric_limits<double>::infinity();
-  row.max_J_ratio = 0.0;
+JRatioRange j_ratio_range(const std::vector<double>& ratio, const std::vector<Vec2>& reference_position) {
+  JRatioRange range{std::numeric_limits<double>::infinity(), 0.0,
+                    Vec2::Constant(std::numeric_limits<double>::quiet_NaN())};
   double farthest = -1.0;
   bool not_a_number = false;
-  for (std::size_t p = 0; p < j_ratio_.size(); ++p) {
-    const double r = j_ratio_[p];
+  for (std::size_t p = 0; p < ratio.size(); ++p) {
+    const double r = ratio[p];
     const double distance = r > 0.0 ? std::abs(std::log(r)) : std::numeric_limits<double>::infinity();
     if (!(distance <= farthest)) {  // NaN is farther than anything
       farthest = distance;
-      row.worst_J_reference = P.reference_position[p];
+      range.worst_reference = reference_position[p];
     }
     not_a_number = not_a_number || std::isnan(r);
-    row.min_J_ratio = std::min(row.min_J_ratio, r);
-    row.max_J_ratio = std::max(row.max_J_ratio, r);
+    range.min = std::min(range.min, r);
+    range.max = std::max(range.max, r);
   }
-  if (not_a_number) row.min_J_ratio = row.max_J_ratio = std::numeric_limits<double>::quiet_NaN();
+  if (not_a_number) range.min = range.max = std::numeric_limits<double>::quiet_NaN();
+  return range;
 }
 
-void MonitorLog::sample_motion(double t, const Particles& P, const mms::ExactSolution& solution) {
+void MonitorLog::record_J_ratio(const Particles& P) {
+  Row& row = rows_.back();
+  const JRatioRange range = j_ratio_range(j_ratio_, P.reference_position);
+  row.min_J_ratio = range.min;
+  row.max_J_ratio = range.max;
+  if (!j_ratio_.empty()) row.worst_J_reference = range.worst_reference;
+}
+
+double sampled_exact_motion(double t, const Particles& P, const mms::ExactSolution& solution) {
   const std::size_t n = P.size(), stride = std::max<std::size_t>(1, n / 256);
   double weight = 0.0, exact2 = 0.0;
   for (std::size_t p = 0; p < n; p += stride) {
@@ -73,7 +80,11 @@ void MonitorLog::sample_motion(double t, const Particles& P, const mms::ExactSol
     weight += P.reference_volume[p];
     exact2 += P.reference_volume[p] * (solution.position(X, t) - X).squaredNorm();
   }
-  if (weight > 0.0) sampled_motion_ = std::max(sampled_motion_, std::sqrt(exact2 / weight));
+  return weight > 0.0 ? std::sqrt(exact2 / weight) : 0.0;
+}
+
+void MonitorLog::sample_motion(double t, const Particles& P, const mms::ExactSolution& solution) {
+  sampled_motion_ = std::max(sampled_motion_, sampled_exact_motion(t, P, solution));
 }
 
 RunHealth MonitorLog::health(const ErrorTable& errors, const HealthRules& rules) const {

@@ -16,6 +16,19 @@
 
 namespace mpmvv::app {
 
+// The range of J_p / J_exact over particles whose ratios are `ratio` (NaN
+// when any is), and the reference position of the particle farthest from 1
+// in ratio (a NaN counts as farthest of all).
+struct JRatioRange {
+  double min, max;
+  Vec2 worst_reference;
+};
+JRatioRange j_ratio_range(const std::vector<double>& ratio, const std::vector<Vec2>& reference_position);
+
+// The RMS exact displacement at t over every k-th particle (about 256 of
+// them, weighted by reference volume); 0 without particles.
+double sampled_exact_motion(double t, const Particles& P, const mms::ExactSolution& solution);
+
 class MonitorLog {
  public:
   struct Row {

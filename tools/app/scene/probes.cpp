@@ -27,6 +27,14 @@ double probe_value(ProbeQuantity q, Geometry geometry, const Vec2& x, const Vec2
   return 0.0;
 }
 
+std::vector<Vec2> ProbeRecorder::tracer_references() const {
+  std::vector<Vec2> X;
+  for (const ProbeLine& line : setup_.lines) X.insert(X.end(), line.reference.begin(), line.reference.end());
+  for (const ProbePoint& point : setup_.points) X.push_back(point.reference);
+  X.insert(X.end(), circle_reference_.begin(), circle_reference_.end());
+  return X;
+}
+
 void ProbeRecorder::seed_tracers(std::vector<Vec2>& tracers) {
   const mms::ExactSolution& s = *setup_.solution;
   line_first_.clear();

@@ -30,6 +30,9 @@ class ProbeRecorder {
   // The probe points and the scene's histories after a step at time t.
   void after_step(double t, const Stepper& s);
 
+  // The material points of the tracers seed_tracers appended, in their order.
+  std::vector<Vec2> tracer_references() const;
+
   // Records the lines and the circle at output time t; returns each line's L1.
   std::vector<double> at_output(double t, const std::vector<Vec2>& tracers);
 

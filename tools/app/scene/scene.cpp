@@ -8,12 +8,14 @@
 
 #include <fmt/format.h>
 
+#include "external_program.hpp"
+
 namespace mpmvv::app {
 
 std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_time,
                                  std::vector<double> default_output_times) {
   const double inf = std::numeric_limits<double>::infinity();
-  return {
+  std::vector<KeySpec> keys = {
       {"method", KeyKind::text, std::string("cpdi"), "shape functions: linear (standard MPM), gimp (uGIMP), cpdi, cpdi-exact (CPDI domains "
        "integrated exactly over the cells they cross), bspline and bspline-cubic (point particles on the grid's "
        "quadratic or cubic B-splines; plane strain, explicit, the body half a cell or a cell clear of the walls)",
@@ -120,6 +122,8 @@ std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_
        "it started with and the largest work done on it",
        0.0, inf, true},
   };
+  for (KeySpec& k : external_program_keys()) keys.push_back(std::move(k));
+  return keys;
 }
 
 SolverOptions solver_options(const Config& c) {

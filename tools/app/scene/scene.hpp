@@ -59,6 +59,12 @@ class SceneCase {
   virtual RunOutcome run(const ProgressSink& progress, const RestartPlan& restart = {}) = 0;
   // A deliberate fault (tools/app/fault.hpp), set before run().
   virtual void inject(Fault fault) = 0;
+  // Where the results file will be written, set before run(): a case that
+  // writes files of its own beside it (an external program's) names them from it.
+  virtual void set_results_path(const std::string& /*path*/) {}
+  // Whether another program made the run (external_command): it took no
+  // steps of mpmvv's, and its method is its own.
+  virtual bool external() const { return false; }
   // Cell size, for the results file.
   virtual double cell_size() const = 0;
   virtual std::size_t particle_count() const = 0;

@@ -1,0 +1,57 @@
+// What an external program writes back (reports/external-format.md): its
+// particles at each output time, as an HDF5 file of /snapshots/<k> groups
+// (the layout of mpmvv's own results file with particle_fields = "outputs")
+// or a folder of CSV files, read into the solver's particle arrays so that
+// the norms are computed by the same code as for mpmvv's own runs.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "solver/particles.hpp"
+
+namespace mpmvv::app {
+
+// Output that is missing or malformed: the message names the file, the
+// group or line, and the item.
+struct ParticleOutputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Which of the optional fields an output held.
+struct OutputFields {
+  bool velocity = false, stress = false, deformation_gradient = false, J = false, volume = false, mass = false;
+  bool tracers = false;
+};
+
+// One output time's particles: P holds reference_position, position and
+// reference_volume, and each field `fields` says was given; the rest are NaN.
+struct OutputState {
+  double time = 0.0;  // the program's own time when it wrote one, else the requested time
+  Particles P;
+  std::vector<double> J;        // det F, from `J`, or volume / reference_volume (empty when neither)
+  std::vector<Vec2> tracers;    // the tracers' current positions, in the input's order (empty when not given)
+  OutputFields fields;
+};
+
+class ParticleOutput {
+ public:
+  // `path` and `format` as the input file named them; `requested` the output times.
+  ParticleOutput(std::string path, std::string format, std::vector<double> requested);
+  // The output for requested time k, or none when the program wrote none
+  // for it; throws ParticleOutputError when what it wrote is malformed
+  // (a missing required item, a row count or a column that does not match,
+  // a time far from the requested one, a tracer count other than `tracers`).
+  std::optional<OutputState> read(std::size_t k, std::size_t tracers) const;
+
+ private:
+  std::optional<OutputState> read_hdf5(std::size_t k, std::size_t tracers) const;
+  std::optional<OutputState> read_csv(std::size_t k, std::size_t tracers) const;
+  std::string path_, format_;
+  std::vector<double> requested_;
+};
+
+}  // namespace mpmvv::app
