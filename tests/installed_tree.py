@@ -97,9 +97,14 @@ with tempfile.TemporaryDirectory() as tmp:
     script = ("import numpy as np, mpmvv\n"
               "X = np.array([[1.0, 0.0], [0.8, 0.5], [-0.3, -0.9]])\n"
               "b = mpmvv.Solution('ring', amplitude=0.5).body_force(X, 0.25)\n"
-              "for x, f in zip(X, b): print('b', *(repr(float(v)) for v in (*x, *f)))\n")
+              "for x, f in zip(X, b): print('b', *(repr(float(v)) for v in (*x, *f)))\n"
+              "try:\n    mpmvv.Solution('ring', nonsense=1)\nexcept ValueError as e:\n    print('error', e)\n")
     program("Python", [], [sys.executable, "-c", script],
             env=dict(os.environ, PYTHONPATH=str(prefix / "lib" / "python3" / "dist-packages")))
+    # A refused setting is named as the library's caller gave it, not as the command line's --set.
+    errors = [line for line in outputs.get("Python", "").splitlines() if line.startswith("error ")]
+    check(len(errors) == 1 and errors[0].startswith("error setting nonsense=1: ") and "--set" not in errors[0],
+          f"the library's message for an unknown key: {errors}")
     forces = {}
     for language, text in outputs.items():
         rows = [line.split()[1:] for line in text.splitlines() if line.startswith("b ")]

@@ -176,22 +176,22 @@ void Config::set(const std::string& key, Value value, Origin origin) {
   origins_[key] = std::move(origin);
 }
 
-void Config::set_from_text(const std::string& assignment) {
+void Config::set_from_text(const std::string& assignment, const std::string& how) {
   const auto eq = assignment.find('=');
   if (eq == std::string::npos || eq == 0)
-    throw ConfigError(fmt::format("--set {}: expected key=value", assignment));
+    throw ConfigError(fmt::format("{} {}: expected key=value", how, assignment));
   const std::string key = trim(assignment.substr(0, eq));
   const std::string text = trim(assignment.substr(eq + 1));
   const KeySpec* found = nullptr;
   try {
     found = &spec(key);
   } catch (const ConfigError& e) {
-    throw ConfigError(fmt::format("--set {}: {}", assignment, e.what()));
+    throw ConfigError(fmt::format("{} {}: {}", how, assignment, e.what()));
   }
   const KeySpec& s = *found;
-  const Origin origin{"--set " + assignment};
+  const Origin origin{how + " " + assignment};
   auto bad = [&]() {
-    throw ConfigError(fmt::format("--set {}: key '{}' must be {}", assignment, key, s.describe_range()));
+    throw ConfigError(fmt::format("{} {}: key '{}' must be {}", how, assignment, key, s.describe_range()));
   };
   switch (s.kind) {
     case KeyKind::integer: {

@@ -62,8 +62,9 @@ class Config {
 
   // Checks `value` against the key's declaration and stores it.
   void set(const std::string& key, Value value, Origin origin);
-  // Parses the text of a `--set key=value` argument.
-  void set_from_text(const std::string& assignment);
+  // Parses the text of a `--set key=value` argument; `how` names where it came
+  // from in a message ("--set" on the command line, "setting" in the C library).
+  void set_from_text(const std::string& assignment, const std::string& how = "--set");
 
   // The resolved configuration as TOML text (all keys, in declaration order).
   std::string to_toml() const;

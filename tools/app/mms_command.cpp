@@ -24,9 +24,9 @@ const SceneType& scene_named(const std::string& name) {
   return *p;
 }
 
-SceneSetup setup_for(const SceneType& scene, const std::vector<std::string>& overrides) {
+SceneSetup setup_for(const SceneType& scene, const std::vector<std::string>& overrides, const std::string& how) {
   Config config(scene.name, scene.keys());
-  for (const std::string& o : overrides) config.set_from_text(o);
+  for (const std::string& o : overrides) config.set_from_text(o, how);
   return scene.setup(config);
 }
 

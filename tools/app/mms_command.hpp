@@ -17,8 +17,10 @@ namespace mpmvv::app {
 
 // The scene of that name; throws ConfigError naming the known ones.
 const SceneType& scene_named(const std::string& name);
-// Its setup with its defaults and the overrides "key=value"; throws ConfigError.
-SceneSetup setup_for(const SceneType& scene, const std::vector<std::string>& overrides);
+// Its setup with its defaults and the overrides "key=value"; throws ConfigError,
+// naming an override as `how` says (Config::set_from_text).
+SceneSetup setup_for(const SceneType& scene, const std::vector<std::string>& overrides,
+                     const std::string& how = "--set");
 // The keys that set the scene's solution (its own and its material's), not the run's.
 std::vector<KeySpec> solution_parameters(const SceneType& scene);
 

@@ -150,7 +150,7 @@ mpmvv_mms_solution* mpmvv_mms_create(const char* name, int count, const char* co
       overrides.emplace_back(settings[k]);
     }
     auto s = std::make_unique<mpmvv_mms_solution>();
-    s->setup = mpmvv::app::setup_for(scene, overrides);
+    s->setup = mpmvv::app::setup_for(scene, overrides, "setting");
     s->name = scene.name;
     if (!s->setup.force_free)
       s->field = s->setup.fast_body_force ? s->setup.fast_body_force : mpmvv::mms::derived_force_field(s->setup.solution);
