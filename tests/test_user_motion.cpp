@@ -141,3 +141,51 @@ TEST(UserMotion, ARunRefusesAMotionItsBoundaryCannotHold) {
   mpmvv::app::Config fine(scene, mpmvv::app::find_scene_type(scene)->keys());
   EXPECT_FALSE(mpmvv::app::find_scene_type(scene)->setup(fine).run_refused.has_value());
 }
+
+// In r-z the formulas are u_r, u_z of R, Z and t, on [inner_radius, inner_radius
+// + W] x [0, H]; the axis holds u_r = 0, and a motion that moves it is refused.
+TEST(UserMotion, RzFormulasAreOfRAndZAndTheAxisHoldsUr) {
+  const std::string scene = "user-motion";
+  auto config = [&](std::vector<std::string> settings) {
+    mpmvv::app::Config c(scene, mpmvv::app::find_scene_type(scene)->keys());
+    for (const std::string& s : settings) c.set_from_text(s);
+    return c;
+  };
+  const std::vector<std::string> rz = {"geometry=rz", "displacement_y=0", "parameters=A = 0.1, c = 100"};
+  std::vector<std::string> held = rz;
+  held.push_back("displacement_x=A * R * sin(pi * R) * cos(pi * Z) * sin(c * pi * t)");
+  const mpmvv::app::SceneSetup setup = mpmvv::app::find_scene_type(scene)->setup(config(held));
+  EXPECT_EQ(setup.geometry, mpmvv::Geometry::axisymmetric);
+  EXPECT_FALSE(setup.run_refused.has_value()) << setup.run_refused->why;
+  // F_33 = r / R = 1 + u_r / R.
+  const mpmvv::Vec2 X(0.3, 0.2);
+  const double t = 0.004, u_r = 0.1 * 0.3 * std::sin(std::numbers::pi * 0.3) * std::cos(std::numbers::pi * 0.2) * std::sin(100 * std::numbers::pi * t);
+  EXPECT_NEAR(setup.solution->state(X, t).hoop_stretch, 1.0 + u_r / 0.3, 1e-14);
+  // u_r = A (1 - R) ... does not vanish on the axis: refused there.
+  std::vector<std::string> moved = rz;
+  moved.push_back("displacement_x=A * (1 - R) * cos(pi * Z) * sin(c * pi * t)");
+  const mpmvv::app::SceneSetup refused = mpmvv::app::find_scene_type(scene)->setup(config(moved));
+  ASSERT_TRUE(refused.run_refused.has_value());
+  EXPECT_NE(refused.run_refused->why.find("the axis needs u_r = 0"), std::string::npos) << refused.run_refused->why;
+  // The plane-strain formulas' names, and an inner radius in plane strain, are refused with the reason.
+  try {
+    mpmvv::app::find_scene_type(scene)->setup(config({"geometry=rz"}));
+    ADD_FAILURE() << "formulas of X and Y accepted in r-z";
+  } catch (const mpmvv::app::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("in r-z the formulas are of R, Z and t"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(mpmvv::app::find_scene_type(scene)->setup(config({"inner_radius=0.5"})), mpmvv::app::ConfigError);
+}
+
+// A motion whose traction vanishes on free sides, P N there round-off alone,
+// runs: the boundary's values are judged against the stress in the whole body,
+// not against the (vanishing) stress on the boundary.
+TEST(UserMotion, AMotionThatVanishesOnFreeSidesRuns) {
+  const std::string scene = "user-motion";
+  mpmvv::app::Config c(scene, mpmvv::app::find_scene_type(scene)->keys());
+  c.set_from_text("boundary=free");
+  c.set_from_text("displacement_x=0.001 * sin(pi * X) ^ 2 * sin(pi * Y) ^ 2 * sin(100 * t)");
+  c.set_from_text("displacement_y=0");
+  const mpmvv::app::SceneSetup setup = mpmvv::app::find_scene_type(scene)->setup(c);
+  EXPECT_FALSE(setup.run_refused.has_value()) << setup.run_refused->why;
+}

@@ -6,6 +6,10 @@
 // default is the axis-aligned problem (PROBLEMS.md section 3) written as
 // formulas: the same solution as the scene axis-aligned, for comparison.
 //
+// In r-z (geometry = "rz") the same on the rectangle [R_0, R_0 + W] x [0, H]
+// of (R, Z), the formulas u_r, u_z of R, Z, t, the hoop stretch r / R; with
+// R_0 = 0 its left side is the axis, where the motion must keep u_r = 0.
+//
 // The rectangle's sides are either roller walls (boundary = "walls": the grid's
 // walls lie on them, and the motion must keep u . n = 0 and carry no shear
 // traction there) or free (boundary = "free": the motion's traction P N must
@@ -41,7 +45,13 @@ std::vector<KeySpec> keys() {
       {"parameters", KeyKind::text, std::string("A = 0.05, c = 100, L = 1"),
        "the formulas' named constants, \"name = value, ...\"; a value may be a formula of the names before it", -inf,
        inf},
-      {"width", KeyKind::real, 1.0, "W, the rectangle's side along X [m]", 0.0, inf, true},
+      {"geometry", KeyKind::text, std::string("plane-strain"),
+       "plane-strain: u(X, Y, t) on [0, W] x [0, H]; rz: the solver's axisymmetric mode, u_r and u_z as formulas of "
+       "R, Z, t on [inner_radius, inner_radius + W] x [0, H] (the hoop stretch r / R)",
+       -inf, inf, false, false, {"plane-strain", "rz"}},
+      {"inner_radius", KeyKind::real, 0.0,
+       "rz: R_0, the rectangle's inner side [m]; 0: the body reaches the axis, where u_r must vanish", 0.0, inf},
+      {"width", KeyKind::real, 1.0, "W, the rectangle's side along X (R in r-z) [m]", 0.0, inf, true},
       {"height", KeyKind::real, 1.0, "H, its side along Y [m]; a whole number of cells of W / cells", 0.0, inf, true},
       {"boundary", KeyKind::text, std::string("walls"),
        "walls: roller walls on the rectangle's sides (u . n = 0 and no shear traction there); free: traction-free "
@@ -74,7 +84,7 @@ std::map<std::string, double> read_parameters(const Config& c) {
     if (!(std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_') ||
         !std::all_of(name.begin(), name.end(), [](char ch) { return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_'; }))
       c.reject("parameters", fmt::format("'{}' is not a name (letters, digits, _)", name));
-    if (name == "X" || name == "Y" || name == "t" || mms::Expression::reserved(name))
+    if (name == "X" || name == "Y" || name == "R" || name == "Z" || name == "t" || mms::Expression::reserved(name))
       c.reject("parameters", fmt::format("'{}' is a coordinate, time, pi or a function", name));
     if (parameters.count(name)) c.reject("parameters", fmt::format("'{}' is given twice", name));
     try {
@@ -88,34 +98,44 @@ std::map<std::string, double> read_parameters(const Config& c) {
   return parameters;
 }
 
-mms::Expression read_formula(const Config& c, const std::string& key, const std::map<std::string, double>& parameters) {
+mms::Expression read_formula(const Config& c, const std::string& key, const std::map<std::string, double>& parameters,
+                             bool rz) {
   try {
-    return mms::Expression(c.text(key), {"X", "Y", "t"}, parameters);
+    return rz ? mms::Expression(c.text(key), {"R", "Z", "t"}, parameters)
+              : mms::Expression(c.text(key), {"X", "Y", "t"}, parameters);
   } catch (const mms::ExpressionError& e) {
-    c.reject(key, e.what());
+    c.reject(key, fmt::format("{}{}", e.what(), rz ? " (in r-z the formulas are of R, Z and t)" : ""));
   }
 }
 
 // The motion against the rectangle's boundary, at 21 points of each side and 8
 // times in (0, end_time]: with walls u . n = 0 and (P N) . s = 0, free P N = 0,
-// each to 1e-8 of the largest |u| and |P - P(I)| seen on the boundary; the
-// first point that breaks it makes runs refuse the setup. Returns the largest
-// |u| (the motion's reach).
-double check_boundary(const Config& c, SceneSetup& setup, double W, double H, bool walls) {
+// each to 1e-8 of the largest |u| and |P - P(I)| in the body; on the
+// axis (r-z, R_0 = 0) u_r = 0 whatever the boundary; the first point that
+// breaks it makes runs refuse the setup. Returns the largest |u| (the motion's
+// reach).
+double check_boundary(const Config& c, SceneSetup& setup, double R0, double W, double H, bool walls, bool axis) {
   const mms::ExactSolution& solution = *setup.solution;
   struct Sample {
     Vec2 X, normal;
     double t, u_normal, traction;
+    bool on_axis;
   };
   std::vector<Sample> samples;
   const double end = c.real("end_time");
   double reach = 0.0, stress = 0.0;
-  const Mat2 rest = solution.state(Vec2(0.5 * W, 0.5 * H), 0.0).first_piola;
+  const Mat2 rest = solution.state(Vec2(R0 + 0.5 * W, 0.5 * H), 0.0).first_piola;
   for (int side = 0; side < 4; ++side)
     for (int k = 0; k <= 20; ++k)
       for (int m = 1; m <= 8; ++m) {
         const double s = k / 20.0;
-        const Vec2 X = side == 0 ? Vec2(s * W, 0.0) : side == 1 ? Vec2(W, s * H) : side == 2 ? Vec2(s * W, H) : Vec2(0.0, s * H);
+        Vec2 X = Vec2(R0, 0.0) + (side == 0   ? Vec2(s * W, 0.0)
+                                  : side == 1 ? Vec2(W, s * H)
+                                  : side == 2 ? Vec2(s * W, H)
+                                              : Vec2(0.0, s * H));
+        const bool on_axis = axis && X.x() == 0.0;  // the left side and the corners on it
+        if (on_axis && side != 3) continue;         // the corners are the left side's ends
+        if (on_axis) X.x() = 1e-9 * W;             // the hoop stretch r / R is 0 / 0 on the axis itself
         const Vec2 n = side == 0 ? Vec2(0.0, -1.0) : side == 1 ? Vec2(1.0, 0.0) : side == 2 ? Vec2(0.0, 1.0) : Vec2(-1.0, 0.0);
         const double t = end * m / 8.0;
         const mms::ExactFields f = solution.state(X, t);
@@ -123,23 +143,43 @@ double check_boundary(const Config& c, SceneSetup& setup, double W, double H, bo
         const Vec2 tangent(-n.y(), n.x());
         reach = std::max(reach, f.displacement.norm());
         stress = std::max(stress, (f.first_piola - rest).cwiseAbs().maxCoeff());
-        samples.push_back({X, n, t, f.displacement.dot(n), walls ? traction.dot(tangent) : traction.norm()});
+        samples.push_back({X, n, t, f.displacement.dot(n), walls || on_axis ? traction.dot(tangent) : traction.norm(),
+                           on_axis});
       }
+  // The scales the boundary's values are judged against: the largest |u| and
+  // |P - P(I)| over the body (an 11 x 11 lattice inside it at the same times)
+  // as well as its boundary, so that a motion that vanishes on the boundary
+  // is not held to its own round-off there.
+  double body_reach = reach, body_stress = stress;
+  for (int i = 0; i <= 10; ++i)
+    for (int j = 0; j <= 10; ++j)
+      for (int m = 1; m <= 8; ++m) {
+        const Vec2 X = Vec2(R0, 0.0) + Vec2(W * (0.05 + 0.09 * i), H * (0.05 + 0.09 * j));
+        const mms::ExactFields f = solution.state(X, end * m / 8.0);
+        if (!(f.displacement.allFinite() && f.first_piola.allFinite())) continue;  // named below, on the boundary
+        body_reach = std::max(body_reach, f.displacement.norm());
+        body_stress = std::max(body_stress, (f.first_piola - rest).cwiseAbs().maxCoeff());
+      }
+  // A motion that moves the axis has a hoop stretch 1 + u_r / R that is no
+  // number near it: the axis is checked, and named, first.
+  std::stable_partition(samples.begin(), samples.end(), [](const Sample& s) { return s.on_axis; });
   for (const Sample& s : samples) {
-    if (!(std::isfinite(s.u_normal) && std::isfinite(s.traction)))
+    const bool moves_axis = s.on_axis && !(std::abs(s.u_normal) <= 1e-8 * body_reach);
+    if (!moves_axis && !(std::isfinite(s.u_normal) && std::isfinite(s.traction)))
       c.reject("displacement_x", fmt::format("the motion is not a number at X = ({:.4g}, {:.4g}), t = {:.4g}", s.X.x(),
                                              s.X.y(), s.t));
     if (setup.run_refused) break;
-    if (walls && std::abs(s.u_normal) > 1e-8 * reach)
-      setup.run_refused = {"boundary", fmt::format("the motion crosses a roller wall: at X = ({:.4g}, {:.4g}), t = {:.4g} its u . n "
-                                       "= {:.3g} m (largest |u| on the boundary {:.3g} m); walls need u . n = 0",
-                                       s.X.x(), s.X.y(), s.t, s.u_normal, reach)};
-    else if (std::abs(s.traction) > 1e-8 * stress)
+    if (moves_axis || (walls && std::abs(s.u_normal) > 1e-8 * body_reach))
+      setup.run_refused = {"boundary", fmt::format("the motion crosses {}: at X = ({:.4g}, {:.4g}), t = {:.4g} its u . n "
+                                       "= {:.3g} m (largest |u| in the body {:.3g} m); {}",
+                                       s.on_axis ? "the axis" : "a roller wall", s.X.x(), s.X.y(), s.t, s.u_normal,
+                                       body_reach, s.on_axis ? "the axis needs u_r = 0" : "walls need u . n = 0")};
+    else if (std::abs(s.traction) > 1e-8 * body_stress && !(s.on_axis && !walls))
       setup.run_refused = {"boundary",
-               fmt::format("the motion carries {} at X = ({:.4g}, {:.4g}), t = {:.4g}: {:.3g} Pa (largest stress on the "
-                           "boundary {:.3g} Pa); {} and no boundary condition here applies a traction",
+               fmt::format("the motion carries {} at X = ({:.4g}, {:.4g}), t = {:.4g}: {:.3g} Pa (largest stress in the "
+                           "body {:.3g} Pa); {} and no boundary condition here applies a traction",
                            walls ? "a shear traction on a roller wall" : "a traction on a free side", s.X.x(), s.X.y(),
-                           s.t, s.traction, stress,
+                           s.t, s.traction, body_stress,
                            walls ? "walls need (P N) . s = 0" : "free sides need P N = 0")};
   }
   return reach;
@@ -148,14 +188,17 @@ double check_boundary(const Config& c, SceneSetup& setup, double W, double H, bo
 SceneSetup setup(const Config& c) {
   SceneSetup s;
   s.material = material_from(c);
-  s.geometry = Geometry::plane_strain;
-  const double W = c.real("width"), H = c.real("height");
+  const bool rz = c.text("geometry") == "rz";
+  s.geometry = rz ? Geometry::axisymmetric : Geometry::plane_strain;
+  const double W = c.real("width"), H = c.real("height"), R0 = c.real("inner_radius");
+  if (!rz && R0 != 0.0) c.reject("inner_radius", "is the inner side of the r-z rectangle: set geometry = \"rz\"");
   const std::map<std::string, double> parameters = read_parameters(c);
-  mms::ExpressionMotion motion{read_formula(c, "displacement_x", parameters),
-                               read_formula(c, "displacement_y", parameters), std::max(W, H), c.real("time_scale")};
+  mms::ExpressionMotion motion{read_formula(c, "displacement_x", parameters, rz),
+                               read_formula(c, "displacement_y", parameters, rz), std::max(W, H), c.real("time_scale")};
   s.solution = mms::make_solution(motion, s.material, c.real("density"), s.geometry);
   const bool walls = c.text("boundary") == "walls";
-  const double reach = check_boundary(c, s, W, H, walls);
+  const bool axis = rz && R0 == 0.0;  // the left side is the axis
+  const double reach = check_boundary(c, s, R0, W, H, walls, axis);
 
   const int cells = int(c.integer("cells"));
   const double h = W / cells;
@@ -164,24 +207,27 @@ SceneSetup setup(const Config& c) {
     c.reject("height", fmt::format("with walls must be a whole number of cells (W / cells = {:.6g} m): it is {:.6g} of them",
                                    h, rows));
   if (walls) {
-    s.grid = GridGeometry::walled(Vec2::Zero(), h, cells, int(std::round(rows)));
+    s.grid = GridGeometry::walled(Vec2(R0, 0.0), h, cells, int(std::round(rows)));
   } else {
+    // Free sides: the grid two cells and the motion's reach beyond them; in r-z
+    // not past the axis, which is a wall (the grid's r >= 0).
     const int margin = int(std::ceil(reach / h)) + 2;
-    s.grid = GridGeometry::walled(Vec2(-margin * h, -margin * h), h, cells + 2 * margin,
+    const int left = rz ? std::min(margin, int(std::floor(R0 / h + 1e-9))) : margin;
+    s.grid = GridGeometry::walled(Vec2(R0 - left * h, -margin * h), h, cells + left + margin,
                                   int(std::ceil(rows - 1e-9)) + 2 * margin);
   }
-  s.body_is_rectangle(Vec2::Zero(), Vec2(W, H));
+  s.body_is_rectangle(Vec2(R0, 0.0), Vec2(R0 + W, H));
 
   const int n = int(c.integer("probe_points"));
   ProbeLine along_x{"line_y_mid", ProbeQuantity::displacement_x, "reference_x", {}, {}, std::nullopt};
-  along_x.reference = points_on_segment(Vec2(0.0, 0.5 * H), Vec2(W, 0.5 * H), n);
+  along_x.reference = points_on_segment(Vec2(R0, 0.5 * H), Vec2(R0 + W, 0.5 * H), n);
   for (const Vec2& X : along_x.reference) along_x.parameter.push_back(X.x());
   s.lines.push_back(std::move(along_x));
   ProbeLine along_y{"line_x_mid", ProbeQuantity::displacement_y, "reference_y", {}, {}, std::nullopt};
-  along_y.reference = points_on_segment(Vec2(0.5 * W, 0.0), Vec2(0.5 * W, H), n);
+  along_y.reference = points_on_segment(Vec2(R0 + 0.5 * W, 0.0), Vec2(R0 + 0.5 * W, H), n);
   for (const Vec2& X : along_y.reference) along_y.parameter.push_back(X.y());
   s.lines.push_back(std::move(along_y));
-  s.points.push_back({"point_quarter", ProbeQuantity::displacement_x, Vec2(0.25 * W, 0.25 * H)});
+  s.points.push_back({"point_quarter", ProbeQuantity::displacement_x, Vec2(R0 + 0.25 * W, 0.25 * H)});
   return s;
 }
 
