@@ -29,7 +29,7 @@ from pathlib import Path
 
 from . import gate
 from . import orders
-from .report_figures import study_figures
+from .report_figures import external_comparison_figure, study_figures
 from .report_rows import LEVELS_CSV_COLUMNS, ORDERS_CSV_COLUMNS, gci_rows, order_rows, stored_norm_check
 from .report_tables import (case_table, expectation_table, gci_table, measurement_sections, orders_table,
                            reference_sections, write_gci_csv, write_levels_csv,
@@ -107,6 +107,9 @@ def build_report(suite, figure_directory):
                      f"two levels is at most ({orders.ROUNDOFF_ULPS} + steps) ulps of the point's |X| (pi for an "
                      "angle), which rounding alone can explain: no order, extrapolation or GCI.", gci_table(grid_rows)))
     entries = [e for study in suite.study_names() for e in study_figures(suite, study, rows, figure_directory)]
+    comparison = external_comparison_figure(suite, figure_directory)
+    if comparison is not None:
+        entries.insert(0, comparison)
     return Report(suite, datetime.now(), status_counts(suite), stored_norm_check(suite), rows, grid_rows,
                   sections, entries, verdicts, gate_error)
 

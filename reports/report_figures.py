@@ -89,6 +89,36 @@ def work_precision_figure(study, all_series, norm, unit, styles, directory):
                                     f"more accurate).")
 
 
+def external_comparison_figure(suite, directory):
+    """Every study of the suite in one work-precision figure when one of them is run by
+    another program (external_command): that program's error at equal run time beside
+    mpmvv's own studies. None for a suite without such a study, or with it alone."""
+    studies = suite.study_names()
+    external = [s for s in studies if any(c.keys.get("external_command") for c in suite.cases_of(s))]
+    if not external or len(studies) < 2:
+        return None
+    pairs = figure_norms(suite, external[0], suite.cases_of(external[0]))
+    if not pairs:
+        return None
+    norm = pairs[0][0]
+    curves = []
+    for k, study in enumerate(studies):
+        for m, series in enumerate(study_series(suite, study)):
+            points = [(c.wall_time_s, lookup_error(c, norm, c.end_time)[0]) for c in series.cases if c.completed]
+            style = figures.Style(figures.COLOURS[k % len(figures.COLOURS)], figures.MARKERS[m % len(figures.MARKERS)])
+            curves.append(figures.Curve(f"{study} ({series.label})", [p[0] for p in points], [p[1] for p in points],
+                                        style))
+    quantities = line_quantities(suite.cases)
+    figure = figures.work_precision([("every study", curves)], f"work against precision across the studies, {norm} "
+                                    "at the end time", f"{norm} [{norms.norm_unit(norm, quantities)}]")
+    path = saved(figure, directory, "suite", "work-precision")
+    return FigureEntry("all studies", path,
+                       f"{norm} at the end time against wall time for the completed cases of every study, one curve "
+                       f"per study and series (each across its refinement), the external program's "
+                       f"({', '.join(external)}: its own wall time as mpmvv measured it around the program) beside "
+                       f"the others; circled: Pareto front (no case is both faster and more accurate).")
+
+
 def stability_cell(case):
     if case.results is None:
         return figures.StabilityCell(float("nan"), case.status, stopped=True)

@@ -30,8 +30,10 @@ def case_table(suite):
     rows, css = [], []
     for c in suite.cases:
         reached = f"{number(c.time_reached)} / {number(c.end_time)}"
+        # A case another program ran (external_command): mpmvv does not see its steps.
+        steps = "external program" if c.keys.get("external_command") else number(c.attribute("steps"), "g")
         rows.append([c.id, c.status, reached, "" if c.completed else c.failure_reason, number(c.wall_time_s),
-                     number(c.attribute("steps"), "g"), number(c.attribute("particle_count"), "g")])
+                     steps, number(c.attribute("particle_count"), "g")])
         css.append(c.status)
     return Table(["case", "status", "reached / end time [s]", "failure reason", "wall time [s]", "steps",
                   "particles"], rows, css)

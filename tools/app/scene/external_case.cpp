@@ -115,6 +115,7 @@ class ExternalCase final : public SceneCase {
       const bool finite = std::all_of(state->P.position.begin(), state->P.position.end(),
                                       [](const Vec2& x) { return x.allFinite(); });
       last_ = std::move(state->P);
+      last_J_ = std::move(state->J);
       if (!finite)
         return finish(o, k, "nan", fmt::format("a particle position is not a number at t = {:.6g} s",
                                                loop_.output_times[k]));
@@ -161,7 +162,7 @@ class ExternalCase final : public SceneCase {
   }
 
   void write_results(h5::Group& root) const override {
-    write_particles(root, last_);
+    write_particles(root, last_, !fields_.deformation_gradient && last_J_.size() == last_.size() ? &last_J_ : nullptr);
     write_particle_index(root, last_.size());
     h5::Group probes = root.create_group("probes");
     write_probes(probes, probes_);
@@ -256,7 +257,8 @@ class ExternalCase final : public SceneCase {
   ProgramEnd end_;
   RunOutcome outcome_;
   OutputFields fields_;
-  Particles last_;  // the particles of the last output read
+  Particles last_;            // the particles of the last output read
+  std::vector<double> last_J_;  // their J from J or the volumes (empty when not given)
   ErrorTable errors_;
   TimeIntegral integrated_;
   std::vector<double> j_ratio_, program_time_;

@@ -131,9 +131,10 @@ std::string expand_command(const std::string& templ, const Config& config, const
 void write_external_input(const ExternalFiles& files, const Config& config, const std::vector<double>& output_times,
                           const std::vector<Vec2>& tracer_reference, const std::vector<Vec2>& tracer_start,
                           const std::string& format) {
-  // The scene as mpmvv itself would run it: the program is the solver now.
+  // The scene as mpmvv itself would run it: the program is the solver now
+  // (external_format and external_timeout stay, as what the harness asked for).
   Config own = config;
-  for (const KeySpec& k : external_program_keys()) own.set(k.name, k.default_value, Origin{"external program input"});
+  own.set("external_command", std::string(), Origin{"external program input"});
   Json keys = Json::object();
   for (const KeySpec& k : own.specs()) keys[k.name] = value_json(own.value(k.name));
   auto points = [](const std::vector<Vec2>& list) {

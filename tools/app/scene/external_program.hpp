@@ -46,7 +46,7 @@ std::string expand_command(const std::string& templ, const Config& config, const
                            const std::string& executable, int threads);
 
 // The input files: `files.scene`, a scene file holding every key of the
-// resolved configuration, the external keys cleared (what mpmvv run itself
+// resolved configuration, external_command cleared (what mpmvv run itself
 // would run); `files.input`, JSON with the scene, every key, the output
 // times, the end time, the tracers (each probe's material point X and its
 // position at t = 0, in the order their positions are read back), the

@@ -134,7 +134,7 @@ void write_errors(h5::Group& root, const ErrorTable& errors, const std::string& 
 // Each field is written a block of rows at a time from the particle arrays
 // (h5::Group::write_rows): staging the whole set would add 12 doubles a
 // particle (20 with corner domains) to the run's memory at its last moment.
-void write_particles(h5::Group& root, const Particles& P) {
+void write_particles(h5::Group& root, const Particles& P, const std::vector<double>* J) {
   h5::Group g = root.create_group("particles");
   const std::size_t n = P.size();
   // Rows of `per_row` 2-vectors from a field that holds them one row after another.
@@ -155,7 +155,7 @@ void write_particles(h5::Group& root, const Particles& P) {
   g.write_rows("position", {n, 2}, vectors(P.position));
   g.write_rows("velocity", {n, 2}, vectors(P.velocity));
   g.write_rows("volume", {n}, scalars([&](std::size_t p) { return P.volume[p]; }));
-  g.write_rows("J", {n}, scalars([&](std::size_t p) { return determinant(P.deformation_gradient[p]); }));
+  g.write_rows("J", {n}, scalars([&](std::size_t p) { return J ? (*J)[p] : determinant(P.deformation_gradient[p]); }));
   g.write_rows("deformation_gradient", {n, 2, 2}, [&](std::size_t first, std::size_t count, double* out) {
     for (std::size_t p = first; p < first + count; ++p)
       for (int k = 0; k < 4; ++k) *out++ = P.deformation_gradient[p](k / 2, k % 2);

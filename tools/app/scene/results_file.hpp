@@ -38,7 +38,9 @@ void write_results_file(const std::string& path, const RunIdentity& identity, co
                         const SceneCase& scene, const RunOutcome& o, const RunHealth& health, Fault fault);
 
 // The groups a scene writes (SceneCase::write_results).
-void write_particles(h5::Group& root, const Particles& particles);
+// `J`: each particle's J when F does not give it (an external program's J or
+// volumes); null: det F.
+void write_particles(h5::Group& root, const Particles& particles, const std::vector<double>* J = nullptr);
 // /particle_index: 0 .. count - 1, the particles as cells of one vertex each
 // for the .xmf sidecar (xdmf_file.hpp); count the most particles any group holds.
 void write_particle_index(h5::Group& root, std::size_t count);
