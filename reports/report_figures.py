@@ -71,11 +71,16 @@ def error_figure(study, norm, time, rows, styles, quantities, directory):
     return FigureEntry(study, path, caption)
 
 
+def work_points(series, norm):
+    """(wall time, error at the end time) of the series' completed cases."""
+    return [(c.wall_time_s, lookup_error(c, norm, c.end_time)[0]) for c in series.cases if c.completed]
+
+
 def work_precision_figure(study, all_series, norm, unit, styles, directory):
     panels = {}
     for series in all_series:
         method, problem = split_label(series)
-        points = [(c.wall_time_s, lookup_error(c, norm, c.end_time)[0]) for c in series.cases if c.completed]
+        points = work_points(series, norm)
         curve = figures.Curve(method or series.label, [p[0] for p in points], [p[1] for p in points],
                               styles[series.label])
         panels.setdefault(problem, []).append(curve)
@@ -104,7 +109,7 @@ def external_comparison_figure(suite, directory):
     curves = []
     for k, study in enumerate(studies):
         for m, series in enumerate(study_series(suite, study)):
-            points = [(c.wall_time_s, lookup_error(c, norm, c.end_time)[0]) for c in series.cases if c.completed]
+            points = work_points(series, norm)
             style = figures.Style(figures.COLOURS[k % len(figures.COLOURS)], figures.MARKERS[m % len(figures.MARKERS)])
             curves.append(figures.Curve(f"{study} ({series.label})", [p[0] for p in points], [p[1] for p in points],
                                         style))

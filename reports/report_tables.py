@@ -163,12 +163,12 @@ def _per_level(row, value):
 
 
 def order_row_values(r):
-    """One row of orders.csv, in the order of ORDERS_CSV_COLUMNS (summary.json takes the same values)."""
+    """One row of orders.csv as values, in the order of ORDERS_CSV_COLUMNS (summary.json takes the same)."""
     finest = r.levels[-1] if r.levels else None
-    return [r.study, r.series.label, r.norm, r.unit, repr(r.time), r.series.refine, len(r.levels), len(r.left_out),
-            *(repr(v if r.has_order else float("nan")) for v in (r.fit.order, r.fit.ci_low, r.fit.ci_high)),
-            r.classification, finest.value if finest else "", repr(finest.h) if finest else "",
-            repr(finest.error) if finest else ""]
+    return [r.study, r.series.label, r.norm, r.unit, r.time, r.series.refine, len(r.levels), len(r.left_out),
+            *(v if r.has_order else float("nan") for v in (r.fit.order, r.fit.ci_low, r.fit.ci_high)),
+            r.classification, finest.value if finest else "", finest.h if finest else "",
+            finest.error if finest else ""]
 
 
 def write_orders_csv(rows, path):
@@ -176,7 +176,7 @@ def write_orders_csv(rows, path):
         writer = csv.writer(stream)
         writer.writerow([name for name, _ in ORDERS_CSV_COLUMNS])
         for r in rows:
-            writer.writerow(order_row_values(r))
+            writer.writerow([repr(v) if isinstance(v, float) else v for v in order_row_values(r)])
 
 
 def write_levels_csv(rows, path):

@@ -30,15 +30,12 @@ def _integer(v):
 
 
 def _value(v):
-    """A CSV cell as JSON has it: numbers as numbers (None when not finite), the rest as text."""
+    """An orders.csv value as JSON has it: numbers as numbers (None when not finite), an empty cell None."""
     if isinstance(v, numbers.Integral) and not isinstance(v, bool):
         return int(v)
-    if isinstance(v, float):
+    if isinstance(v, numbers.Real):
         return _number(v)
-    try:
-        return _number(float(v)) if str(v).strip().lower() not in ("", "inf", "-inf", "nan") else None
-    except ValueError:
-        return str(v)
+    return None if v in ("", None) else v
 
 
 def case_record(suite, case):

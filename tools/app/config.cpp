@@ -110,6 +110,11 @@ std::string format_value(const Value& v) {
       v);
 }
 
+std::string as_setting(const Value& v) {
+  if (const auto* s = std::get_if<std::string>(&v)) return *s;
+  return format_value(v);
+}
+
 Config::Config(std::string scene, std::vector<KeySpec> specs) : scene_(std::move(scene)), specs_(std::move(specs)) {
   for (const KeySpec& s : specs_) {
     values_[s.name] = s.default_value;

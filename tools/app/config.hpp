@@ -80,6 +80,8 @@ class Config {
 };
 
 std::string format_value(const Value& v);
+// The value as `mpmvv run --set` reads it: text as it stands, the rest as format_value.
+std::string as_setting(const Value& v);
 
 // Reads a scene file. `specs_for_scene` returns the declarations of the scene
 // named by the file's `scene` key, or nothing when there is no such scene.

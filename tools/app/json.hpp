@@ -6,6 +6,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "config.hpp"
+
 namespace mpmvv::app {
 
 using Json = nlohmann::ordered_json;
@@ -14,6 +16,11 @@ using Json = nlohmann::ordered_json;
 // UTF-8 (a solver's message) as U+FFFD, so the text always parses.
 inline std::string json_text(const Json& j, int indent = -1) {
   return j.dump(indent, ' ', false, Json::error_handler_t::replace);
+}
+
+// A configuration value as JSON: a number, a string or a list of numbers.
+inline Json json_of(const Value& v) {
+  return std::visit([](const auto& x) { return Json(x); }, v);
 }
 
 }  // namespace mpmvv::app

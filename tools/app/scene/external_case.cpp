@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <limits>
 #include <numeric>
+#include <string_view>
 
 #include <fmt/format.h>
 
@@ -26,15 +27,14 @@ namespace {
 namespace fs = std::filesystem;
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
-// Which of kParticleNorms an output's fields give (norms.hpp: particle_norms
-// computes all of them; a norm of a field the program did not write is left out).
-bool norm_given(std::size_t column, const OutputFields& f) {
-  switch (column) {
-    case 3: return f.stress;                // particle_pressure_L2
-    case 4: return f.deformation_gradient;  // particle_deformation_L2
-    case 5: return f.velocity;              // particle_velocity_L2
-    default: return true;                   // the displacement norms: positions only
-  }
+// Whether an output's fields give the norm of kParticleNorms (norms.hpp:
+// particle_norms computes all of them; a norm of a field the program did not
+// write is left out). The displacement norms need the positions only.
+bool norm_given(std::string_view norm, const OutputFields& f) {
+  if (norm == "particle_pressure_L2") return f.stress;
+  if (norm == "particle_deformation_L2") return f.deformation_gradient;
+  if (norm == "particle_velocity_L2") return f.velocity;
+  return true;
 }
 
 std::string fields_text(const OutputFields& f) {
@@ -105,7 +105,7 @@ class ExternalCase final : public SceneCase {
       }
       if (!state) break;
       if (k == 0) start(*state);
-      else if (!same_fields(state->fields))
+      else if (state->fields != fields_)
         return finish(o, k, "malformed output",
                       fmt::format("output {} holds {}; output 0 held {}", k, fields_text(state->fields),
                                   fields_text(fields_)));
@@ -131,7 +131,6 @@ class ExternalCase final : public SceneCase {
       return finish(o, k, end_.succeeded() ? "missing output" : "external program failed", detail);
     }
     o.completed = true;
-    outcome_ = o;
     return o;
   }
 
@@ -188,11 +187,6 @@ class ExternalCase final : public SceneCase {
 
  private:
   bool j_given() const { return fields_.deformation_gradient || fields_.J; }
-  bool same_fields(const OutputFields& f) const {
-    return f.velocity == fields_.velocity && f.stress == fields_.stress &&
-           f.deformation_gradient == fields_.deformation_gradient && f.J == fields_.J && f.volume == fields_.volume &&
-           f.mass == fields_.mass && f.tracers == fields_.tracers;
-  }
 
   // The columns from what the first output holds; the time integral's first
   // point and the whole motion (health.hpp) from its particles.
@@ -202,7 +196,7 @@ class ExternalCase final : public SceneCase {
     if (fields_.tracers)
       for (const ProbeLine& line : setup_.lines) errors_.add_column("L1_" + line.name);
     for (std::size_t c = 0; c < std::size(kParticleNorms); ++c)
-      if (norm_given(c, fields_)) errors_.add_column(kParticleNorms[c]);
+      if (norm_given(kParticleNorms[c], fields_)) errors_.add_column(kParticleNorms[c]);
     // The exact state at t = 0, as mpmvv seeds it (case.cpp: initial).
     Particles at_start = first.P;
     for (std::size_t p = 0; p < at_start.size(); ++p)
@@ -226,7 +220,7 @@ class ExternalCase final : public SceneCase {
     const std::vector<double> norms =
         particle_norms(s.P, *setup_.solution, setup_.geometry, s.time, integrated_, j_ratio_, spin);
     for (std::size_t c = 0; c < norms.size(); ++c)
-      if (norm_given(c, fields_)) errors_.columns[column++].second.push_back(norms[c]);
+      if (norm_given(kParticleNorms[c], fields_)) errors_.columns[column++].second.push_back(norms[c]);
     // J / J_exact from J or the volumes where F was not given.
     if (!fields_.deformation_gradient && fields_.J)
       for (std::size_t p = 0; p < s.P.size(); ++p) {
@@ -238,12 +232,11 @@ class ExternalCase final : public SceneCase {
     samples_.push_back({loop_.output_times[k], range.min, range.max, range.worst_reference, nan, nan});
   }
 
-  RunOutcome finish(RunOutcome o, std::size_t k, const std::string& reason, const std::string& detail) {
+  RunOutcome finish(RunOutcome o, std::size_t k, const std::string& reason, const std::string& detail) const {
     o.completed = false;
     o.failure_reason = reason;
     o.failure_detail = detail;
     o.failure_time = k < loop_.output_times.size() ? loop_.output_times[k] : o.time_reached;
-    outcome_ = o;
     return o;
   }
 
@@ -255,7 +248,6 @@ class ExternalCase final : public SceneCase {
   std::string results_path_, command_;
   ExternalFiles files_;
   ProgramEnd end_;
-  RunOutcome outcome_;
   OutputFields fields_;
   Particles last_;            // the particles of the last output read
   std::vector<double> last_J_;  // their J from J or the volumes (empty when not given)

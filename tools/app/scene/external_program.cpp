@@ -77,17 +77,6 @@ std::string shell_quoted(const std::string& s) {
   return q + "'";
 }
 
-// A key's value as a program reads it: text as it stands, numbers and lists
-// as the configuration writes them.
-std::string value_text(const Value& v) {
-  if (const std::string* s = std::get_if<std::string>(&v)) return *s;
-  return format_value(v);
-}
-
-Json value_json(const Value& v) {
-  return std::visit([](const auto& x) { return Json(x); }, v);
-}
-
 }  // namespace
 
 std::string expand_command(const std::string& templ, const Config& config, const ExternalFiles& files,
@@ -116,7 +105,7 @@ std::string expand_command(const std::string& templ, const Config& config, const
     if (const auto o = own.find(name); o != own.end()) {
       out += shell_quoted(o->second);
     } else if (config.has(name)) {
-      out += shell_quoted(value_text(config.value(name)));
+      out += shell_quoted(as_setting(config.value(name)));
     } else {
       config.reject("external_command",
                     fmt::format("{{{}}} at character {} is neither a key of scene '{}' nor one of {{input}}, {{scene}}, "
@@ -136,7 +125,7 @@ void write_external_input(const ExternalFiles& files, const Config& config, cons
   Config own = config;
   own.set("external_command", std::string(), Origin{"external program input"});
   Json keys = Json::object();
-  for (const KeySpec& k : own.specs()) keys[k.name] = value_json(own.value(k.name));
+  for (const KeySpec& k : own.specs()) keys[k.name] = json_of(own.value(k.name));
   auto points = [](const std::vector<Vec2>& list) {
     Json j = Json::array();
     for (const Vec2& X : list) j.push_back({X.x(), X.y()});

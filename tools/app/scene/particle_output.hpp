@@ -25,6 +25,7 @@ struct ParticleOutputError : std::runtime_error {
 struct OutputFields {
   bool velocity = false, stress = false, deformation_gradient = false, J = false, volume = false, mass = false;
   bool tracers = false;
+  bool operator==(const OutputFields&) const = default;
 };
 
 // One output time's particles: P holds reference_position, position and

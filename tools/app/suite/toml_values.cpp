@@ -27,11 +27,6 @@ std::optional<Value> to_value(const toml::node& n) {
   return std::nullopt;
 }
 
-std::string as_setting(const Value& v) {
-  if (const auto* s = std::get_if<std::string>(&v)) return *s;
-  return format_value(v);
-}
-
 bool same_value(const Value& a, const Value& b) {
   auto number = [](const Value& v) -> std::optional<double> {
     if (const auto* i = std::get_if<std::int64_t>(&v)) return double(*i);
@@ -40,10 +35,6 @@ bool same_value(const Value& a, const Value& b) {
   };
   if (number(a) && number(b)) return *number(a) == *number(b);
   return a == b;
-}
-
-Json json_of(const Value& v) {
-  return std::visit([](const auto& x) { return Json(x); }, v);
 }
 
 std::string id_part(const Value& v) {

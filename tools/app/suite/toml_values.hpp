@@ -22,13 +22,8 @@ std::string where_in(const std::string& file, const toml::node& n);
 // A TOML value as a configuration value, or nothing for a type no key takes.
 std::optional<Value> to_value(const toml::node& n);
 
-// The value as `mpmvv run --set` reads it.
-std::string as_setting(const Value& v);
-
 // Numbers compare by value (1 equals 1.0); other values by equality.
 bool same_value(const Value& a, const Value& b);
-
-Json json_of(const Value& v);
 
 // The value as a part of a case id (no spaces, no slashes).
 std::string id_part(const Value& v);
