@@ -36,9 +36,9 @@ std::vector<KeySpec> external_program_keys() {
        "time to {output}, and mpmvv computes the norms from them (reports/external-format.md)",
        -inf, inf},
       {"external_format", KeyKind::text, std::string("hdf5"),
-       "what the external program writes at {output}: hdf5 (one file, a group per output time) or csv (a folder, "
-       "a file per output time); reports/external-format.md",
-       -inf, inf, false, false, {"hdf5", "csv"}},
+       "what the external program writes at {output}: hdf5 (one file, a group per output time), csv or vtk (a "
+       "folder, a file per output time: .csv; .vtu, .vtp or legacy .vtk); reports/external-format.md",
+       -inf, inf, false, false, {"hdf5", "csv", "vtk"}},
       {"external_timeout", KeyKind::real, 0.0,
        "seconds after which the external program is ended and the case fails (0: no limit of its own; a suite's "
        "time-out still applies)",
@@ -56,7 +56,7 @@ ExternalFiles external_files(const std::string& results_path, const std::string&
   fs::path stem = fs::absolute(results_path);
   stem.replace_extension();
   const std::string s = stem.string();
-  return {s + ".input.json", s + ".scene.toml", s + (format == "csv" ? ".external" : ".external.h5"),
+  return {s + ".input.json", s + ".scene.toml", s + (format == "hdf5" ? ".external.h5" : ".external"),
           s + ".external.log"};
 }
 

@@ -20,7 +20,7 @@ std::vector<KeySpec> external_program_keys();
 
 struct ExternalProgram {
   std::string command;  // the template, as configured
-  std::string format;   // "hdf5" or "csv": what the program writes at {output}
+  std::string format;   // "hdf5", "csv" or "vtk": what the program writes at {output}
   double timeout = 0.0;  // seconds; 0: none of its own
 };
 // The program `config` names, or none (external_command = "": mpmvv's own solver).

@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <map>
 #include <sstream>
@@ -12,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "solver/io/hdf5.hpp"
+#include "vtk_file.hpp"
 
 namespace mpmvv::app {
 
@@ -56,13 +58,80 @@ double checked_time(double own, const std::vector<double>& requested, std::size_
   return own;
 }
 
+// One output's arrays as mpmvv names them (reference_position, position,
+// reference_volume, velocity, stress, deformation_gradient, J, volume, mass),
+// whatever the file's format: `get` gives an array as rows of `width` values
+// (a tensor's four in-plane entries row-major) or none when the file does not
+// hold it; `spelled` says how the file spells it, for messages.
+struct ArraySource {
+  struct Rows {
+    std::vector<double> values;
+    std::size_t rows = 0;
+  };
+  std::function<std::optional<Rows>(const std::string& name, std::size_t width)> get;
+  std::function<std::string(const std::string& name)> spelled;
+};
+
+// The particles of one output from its arrays: the required three, then each
+// optional field the file holds (OutputFields), with the rows checked.
+void fill_state(OutputState& s, const ArraySource& source, const std::string& where) {
+  auto required = [&](const char* name, std::size_t width) {
+    auto a = source.get(name, width);
+    if (!a)
+      throw ParticleOutputError(fmt::format("{}: no {} ({}, {} and {} are required)", where, source.spelled(name),
+                                            source.spelled("reference_position"), source.spelled("position"),
+                                            source.spelled("reference_volume")));
+    return std::move(*a);
+  };
+  const ArraySource::Rows X = required("reference_position", 2);
+  const std::size_t n = X.rows;
+  auto checked = [&](const char* name, ArraySource::Rows a, std::size_t width) {
+    if (a.rows != n || a.values.size() != n * width)
+      throw ParticleOutputError(fmt::format("{}: {} must have {} rows of {} values ({} particles in {})", where,
+                                            source.spelled(name), n, width, n, source.spelled("reference_position")));
+    return std::move(a.values);
+  };
+  if (X.values.size() != n * 2) checked("reference_position", X, 2);
+  const std::vector<double> x = checked("position", required("position", 2), 2);
+  const std::vector<double> V0 = checked("reference_volume", required("reference_volume", 1), 1);
+  start_state(s, n);
+  for (std::size_t p = 0; p < n; ++p) {
+    s.P.reference_position[p] = Vec2(X.values[2 * p], X.values[2 * p + 1]);
+    s.P.position[p] = Vec2(x[2 * p], x[2 * p + 1]);
+    s.P.reference_volume[p] = V0[p];
+  }
+  auto optional = [&](const char* name, std::size_t width, bool& given) -> std::vector<double> {
+    auto a = source.get(name, width);
+    if (!a) return {};
+    given = true;
+    return checked(name, std::move(*a), width);
+  };
+  if (const auto v = optional("velocity", 2, s.fields.velocity); s.fields.velocity)
+    for (std::size_t p = 0; p < n; ++p) s.P.velocity[p] = Vec2(v[2 * p], v[2 * p + 1]);
+  if (const auto v = optional("stress", 4, s.fields.stress); s.fields.stress)
+    for (std::size_t p = 0; p < n; ++p) s.P.stress[p] << v[4 * p], v[4 * p + 1], v[4 * p + 2], v[4 * p + 3];
+  if (const auto v = optional("deformation_gradient", 4, s.fields.deformation_gradient); s.fields.deformation_gradient)
+    for (std::size_t p = 0; p < n; ++p)
+      s.P.deformation_gradient[p] << v[4 * p], v[4 * p + 1], v[4 * p + 2], v[4 * p + 3];
+  if (auto v = optional("volume", 1, s.fields.volume); s.fields.volume) s.P.volume = std::move(v);
+  if (auto v = optional("mass", 1, s.fields.mass); s.fields.mass) s.P.mass = std::move(v);
+  if (auto v = optional("J", 1, s.fields.J); s.fields.J) s.J = std::move(v);
+}
+
+void check_tracers(std::size_t given, std::size_t tracers, const std::string& where) {
+  if (given != tracers)
+    throw ParticleOutputError(fmt::format("{}: {} tracers, the input file lists {}", where, given, tracers));
+}
+
 }  // namespace
 
 ParticleOutput::ParticleOutput(std::string path, std::string format, std::vector<double> requested)
     : path_(std::move(path)), format_(std::move(format)), requested_(std::move(requested)) {}
 
 std::optional<OutputState> ParticleOutput::read(std::size_t k, std::size_t tracers) const {
-  return format_ == "csv" ? read_csv(k, tracers) : read_hdf5(k, tracers);
+  if (format_ == "csv") return read_csv(k, tracers);
+  if (format_ == "vtk") return read_vtk(k, tracers);
+  return read_hdf5(k, tracers);
 }
 
 std::optional<OutputState> ParticleOutput::read_hdf5(std::size_t k, std::size_t tracers) const {
@@ -75,53 +144,19 @@ std::optional<OutputState> ParticleOutput::read_hdf5(std::size_t k, std::size_t 
   if (!all.has(name)) return std::nullopt;
   const h5::Group g = all.open_group(name);
   const std::string where = fmt::format("{}:/snapshots/{}", path_, name);
-  for (const char* required : {"reference_position", "position", "reference_volume"})
-    if (!g.has(required)) throw ParticleOutputError(fmt::format("{}: no dataset '{}' (it is required)", where, required));
-  OutputState s;
-  std::vector<hsize_t> dims;
-  const std::vector<double> X = g.read_doubles("reference_position", &dims);
-  if (dims.size() != 2 || dims[1] != 2)
-    throw ParticleOutputError(fmt::format("{}/reference_position: must be N x 2", where));
-  const std::size_t n = dims[0];
-  start_state(s, n);
-  // A dataset of n rows of `width` values (N x 2 x 2 counts as N x 4).
-  auto rows = [&](const char* dataset, std::size_t width) {
+  // A dataset of N rows (N x 2 x 2 counts as N x 4).
+  ArraySource source;
+  source.get = [&](const std::string& dataset, std::size_t) -> std::optional<ArraySource::Rows> {
+    if (!g.has(dataset)) return std::nullopt;
     std::vector<hsize_t> d;
-    std::vector<double> v = g.read_doubles(dataset, &d);
-    if (d.empty() || d[0] != n || v.size() != n * width)
-      throw ParticleOutputError(fmt::format("{}/{}: must have {} rows of {} values ({} particles in "
-                                            "reference_position)", where, dataset, n, width, n));
-    return v;
+    ArraySource::Rows a;
+    a.values = g.read_doubles(dataset, &d);
+    a.rows = d.empty() ? 0 : d[0];
+    return a;
   };
-  const std::vector<double> x = rows("position", 2), V0 = rows("reference_volume", 1);
-  for (std::size_t p = 0; p < n; ++p) {
-    s.P.reference_position[p] = Vec2(X[2 * p], X[2 * p + 1]);
-    s.P.position[p] = Vec2(x[2 * p], x[2 * p + 1]);
-    s.P.reference_volume[p] = V0[p];
-  }
-  auto vectors = [&](const char* dataset, std::vector<Vec2>& into, bool& given) {
-    if (!g.has(dataset)) return;
-    const std::vector<double> v = rows(dataset, 2);
-    for (std::size_t p = 0; p < n; ++p) into[p] = Vec2(v[2 * p], v[2 * p + 1]);
-    given = true;
-  };
-  auto tensors = [&](const char* dataset, std::vector<Mat2>& into, bool& given) {
-    if (!g.has(dataset)) return;
-    const std::vector<double> v = rows(dataset, 4);
-    for (std::size_t p = 0; p < n; ++p) into[p] << v[4 * p], v[4 * p + 1], v[4 * p + 2], v[4 * p + 3];
-    given = true;
-  };
-  auto scalars = [&](const char* dataset, std::vector<double>& into, bool& given) {
-    if (!g.has(dataset)) return;
-    into = rows(dataset, 1);
-    given = true;
-  };
-  vectors("velocity", s.P.velocity, s.fields.velocity);
-  tensors("stress", s.P.stress, s.fields.stress);
-  tensors("deformation_gradient", s.P.deformation_gradient, s.fields.deformation_gradient);
-  scalars("volume", s.P.volume, s.fields.volume);
-  scalars("mass", s.P.mass, s.fields.mass);
-  scalars("J", s.J, s.fields.J);
+  source.spelled = [](const std::string& dataset) { return fmt::format("dataset '{}'", dataset); };
+  OutputState s;
+  fill_state(s, source, where);
   if (g.has("tracer_position")) {
     std::vector<hsize_t> d;
     const std::vector<double> t = g.read_doubles("tracer_position", &d);
@@ -205,58 +240,143 @@ std::optional<OutputState> ParticleOutput::read_csv(std::size_t k, std::size_t t
   const std::string path = (fs::path(path_) / fmt::format("particles_{}.csv", k)).string();
   if (!fs::exists(path)) return std::nullopt;
   const CsvTable t = read_csv_table(path);
-  for (const char* required : {"X", "Y", "x", "y", "V0"})
-    if (!t.find(required))
-      throw ParticleOutputError(fmt::format("{}: no column '{}' (X, Y, x, y and V0 are required)", path, required));
-  OutputState s;
-  const std::size_t n = t.find("X")->size();
-  start_state(s, n);
-  const auto& X = *t.find("X");
-  const auto& Y = *t.find("Y");
-  const auto& x = *t.find("x");
-  const auto& y = *t.find("y");
-  const auto& V0 = *t.find("V0");
-  for (std::size_t p = 0; p < n; ++p) {
-    s.P.reference_position[p] = Vec2(X[p], Y[p]);
-    s.P.position[p] = Vec2(x[p], y[p]);
-    s.P.reference_volume[p] = V0[p];
-  }
-  // A group of columns given whole or not at all.
-  auto group = [&](std::initializer_list<const char*> names, bool& given) -> std::vector<const std::vector<double>*> {
-    std::vector<const std::vector<double>*> columns;
-    for (const char* c : names) columns.push_back(t.find(c));
-    const auto present = std::count_if(columns.begin(), columns.end(), [](auto* c) { return c != nullptr; });
-    if (present == 0) return {};
-    if (present != std::ptrdiff_t(columns.size())) {
-      std::string all;
-      for (const char* c : names) all += (all.empty() ? "" : ", ") + std::string(c);
-      throw ParticleOutputError(fmt::format("{}: the columns {} go together: give all or none", path, all));
-    }
-    given = true;
-    return columns;
+  // Each array's columns (the stress's three give its four entries), given
+  // whole or not at all.
+  static const std::map<std::string, std::vector<const char*>> columns = {
+      {"reference_position", {"X", "Y"}}, {"position", {"x", "y"}}, {"reference_volume", {"V0"}},
+      {"velocity", {"vx", "vy"}}, {"stress", {"sxx", "sxy", "sxy", "syy"}},
+      {"deformation_gradient", {"F11", "F12", "F21", "F22"}}, {"volume", {"V"}}, {"mass", {"m"}}, {"J", {"J"}}};
+  auto names = [](const std::string& array) {
+    std::vector<std::string> unique;
+    for (const char* c : columns.at(array))
+      if (std::find(unique.begin(), unique.end(), c) == unique.end()) unique.push_back(c);
+    return unique;
   };
-  if (auto v = group({"vx", "vy"}, s.fields.velocity); !v.empty())
-    for (std::size_t p = 0; p < n; ++p) s.P.velocity[p] = Vec2((*v[0])[p], (*v[1])[p]);
-  if (auto v = group({"sxx", "syy", "sxy"}, s.fields.stress); !v.empty())
-    for (std::size_t p = 0; p < n; ++p) s.P.stress[p] << (*v[0])[p], (*v[2])[p], (*v[2])[p], (*v[1])[p];
-  if (auto v = group({"F11", "F12", "F21", "F22"}, s.fields.deformation_gradient); !v.empty())
-    for (std::size_t p = 0; p < n; ++p) s.P.deformation_gradient[p] << (*v[0])[p], (*v[1])[p], (*v[2])[p], (*v[3])[p];
-  if (auto v = group({"V"}, s.fields.volume); !v.empty()) s.P.volume = *v[0];
-  if (auto v = group({"m"}, s.fields.mass); !v.empty()) s.P.mass = *v[0];
-  if (auto v = group({"J"}, s.fields.J); !v.empty()) s.J = *v[0];
+  ArraySource source;
+  source.spelled = [&](const std::string& array) {
+    const std::vector<std::string> n = names(array);
+    std::string all;
+    for (const std::string& c : n) all += (all.empty() ? "" : ", ") + c;
+    return n.size() == 1 ? fmt::format("column '{}'", all) : fmt::format("columns {}", all);
+  };
+  source.get = [&](const std::string& array, std::size_t width) -> std::optional<ArraySource::Rows> {
+    std::vector<const std::vector<double>*> given;
+    for (const char* c : columns.at(array)) given.push_back(t.find(c));
+    const auto present = std::count_if(given.begin(), given.end(), [](auto* c) { return c != nullptr; });
+    if (present == 0) return std::nullopt;
+    if (present != std::ptrdiff_t(given.size()))
+      throw ParticleOutputError(fmt::format("{}: the {} go together: give all or none", path, source.spelled(array)));
+    ArraySource::Rows a;
+    a.rows = given[0]->size();
+    a.values.resize(a.rows * width);
+    for (std::size_t p = 0; p < a.rows; ++p)
+      for (std::size_t c = 0; c < width; ++c) a.values[p * width + c] = (*given[c])[p];
+    return a;
+  };
+  OutputState s;
+  fill_state(s, source, path);
   const std::string tracer_path = (fs::path(path_) / fmt::format("tracers_{}.csv", k)).string();
   if (fs::exists(tracer_path)) {
     const CsvTable r = read_csv_table(tracer_path);
     const auto* tx = r.find("x");
     const auto* ty = r.find("y");
     if (!tx || !ty) throw ParticleOutputError(fmt::format("{}: needs the columns x and y", tracer_path));
-    if (tx->size() != tracers)
-      throw ParticleOutputError(fmt::format("{}: {} rows, the input file lists {} tracers", tracer_path, tx->size(), tracers));
+    check_tracers(tx->size(), tracers, tracer_path);
     for (std::size_t i = 0; i < tracers; ++i) s.tracers.emplace_back((*tx)[i], (*ty)[i]);
     s.fields.tracers = true;
   }
   s.time = t.time ? checked_time(*t.time, requested_, k, path) : requested_[k];
   finish_state(s, path);
+  return s;
+}
+
+namespace {
+
+// The one file of output k in a folder of VTK files, whichever of .vtu, .vtp
+// and .vtk it is; none when there is none, refused when there are two.
+std::optional<std::string> vtk_file_of(const std::string& folder, const std::string& stem) {
+  std::optional<std::string> found;
+  for (const char* ext : {".vtu", ".vtp", ".vtk"}) {
+    const std::string path = (fs::path(folder) / (stem + ext)).string();
+    if (!fs::exists(path)) continue;
+    if (found) throw ParticleOutputError(fmt::format("{} and {}: one file per output time, not two", *found, path));
+    found = path;
+  }
+  return found;
+}
+
+VtkPoints vtk_points(const std::string& path) {
+  try {
+    return read_vtk_points(path);
+  } catch (const VtkFileError& e) {
+    throw ParticleOutputError(e.what());
+  }
+}
+
+// The program's time from the file's field data: ParaView's TimeValue, or time.
+std::optional<double> vtk_time(const VtkPoints& v, const std::string& path) {
+  for (const char* name : {"TimeValue", "time", "TIME"}) {
+    const auto it = v.field_data.find(name);
+    if (it == v.field_data.end()) continue;
+    if (it->second.values.size() != 1)
+      throw ParticleOutputError(fmt::format("{}: field data '{}' must be one value (the time)", path, name));
+    return it->second.values[0];
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<OutputState> ParticleOutput::read_vtk(std::size_t k, std::size_t tracers) const {
+  const std::optional<std::string> path = vtk_file_of(path_, fmt::format("particles_{}", k));
+  if (!path) return std::nullopt;
+  const VtkPoints v = vtk_points(*path);
+  ArraySource source;
+  source.spelled = [](const std::string& array) {
+    return array == "position" ? std::string("points") : fmt::format("point array '{}'", array);
+  };
+  // VTK's tuples hold 3 components where mpmvv's plane holds 2: a vector's
+  // z and a tensor's third row and column are dropped; a symmetric tensor of
+  // 6 is VTK's order xx, yy, zz, xy, yz, xz.
+  source.get = [&](const std::string& array, std::size_t width) -> std::optional<ArraySource::Rows> {
+    const VtkArray* a = &v.points;
+    if (array != "position") {
+      const auto it = v.point_data.find(array);
+      if (it == v.point_data.end()) return std::nullopt;
+      a = &it->second;
+    }
+    const std::size_t c = a->components, n = a->tuples();
+    std::vector<std::size_t> pick;
+    if (width == c) {
+      for (std::size_t i = 0; i < c; ++i) pick.push_back(i);
+    } else if (width == 2 && c == 3) {
+      pick = {0, 1};
+    } else if (width == 4 && c == 9) {
+      pick = {0, 1, 3, 4};
+    } else if (width == 4 && c == 6 && array == "stress") {
+      pick = {0, 3, 3, 1};
+    } else {
+      throw ParticleOutputError(fmt::format("{}: {} has {} components; mpmvv reads {}", *path, source.spelled(array), c,
+                                            width == 1 ? "1" : width == 2 ? "2 or 3" : array == "stress" ? "4, 6 or 9" : "4 or 9"));
+    }
+    ArraySource::Rows r;
+    r.rows = n;
+    r.values.resize(n * width);
+    for (std::size_t p = 0; p < n; ++p)
+      for (std::size_t i = 0; i < width; ++i) r.values[p * width + i] = a->values[p * c + pick[i]];
+    return r;
+  };
+  OutputState s;
+  fill_state(s, source, *path);
+  if (const auto tracer_path = vtk_file_of(path_, fmt::format("tracers_{}", k))) {
+    const VtkPoints t = vtk_points(*tracer_path);
+    check_tracers(t.points.tuples(), tracers, *tracer_path);
+    for (std::size_t i = 0; i < tracers; ++i) s.tracers.emplace_back(t.points.values[3 * i], t.points.values[3 * i + 1]);
+    s.fields.tracers = true;
+  }
+  const std::optional<double> own = vtk_time(v, *path);
+  s.time = own ? checked_time(*own, requested_, k, *path) : requested_[k];
+  finish_state(s, *path);
   return s;
 }
 

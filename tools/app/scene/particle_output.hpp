@@ -51,6 +51,7 @@ class ParticleOutput {
  private:
   std::optional<OutputState> read_hdf5(std::size_t k, std::size_t tracers) const;
   std::optional<OutputState> read_csv(std::size_t k, std::size_t tracers) const;
+  std::optional<OutputState> read_vtk(std::size_t k, std::size_t tracers) const;
   std::string path_, format_;
   std::vector<double> requested_;
 };

@@ -1,0 +1,198 @@
+// VTK particle files read for an external program (tools/app/scene/vtk_file.hpp,
+// external_format = "vtk"): which VTK component lands in which entry of
+// mpmvv's in-plane vectors and tensors, the two ways base64 runs are joined,
+// legacy binary (big-endian, the old cell layout), and the messages for what
+// cannot be read. tests/external_vtk.py reads whole runs written by meshio.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "tools/app/scene/particle_output.hpp"
+#include "tools/app/scene/vtk_file.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using mpmvv::app::OutputState;
+using mpmvv::app::ParticleOutput;
+using mpmvv::app::ParticleOutputError;
+using mpmvv::app::read_vtk_points;
+using mpmvv::app::VtkFileError;
+
+fs::path folder(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / "mpmvv-vtk-test" / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+void write(const fs::path& path, const std::string& text) {
+  std::ofstream(path, std::ios::binary) << text;
+}
+
+std::string base64(const std::string& bytes) {
+  static const char* digits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (std::size_t i = 0; i < bytes.size(); i += 3) {
+    const std::size_t n = std::min<std::size_t>(3, bytes.size() - i);
+    std::uint32_t bits = 0;
+    for (std::size_t k = 0; k < 3; ++k)
+      bits = (bits << 8) | (k < n ? static_cast<unsigned char>(bytes[i + k]) : 0u);
+    for (std::size_t k = 0; k < 4; ++k) out += k <= n ? digits[(bits >> (18 - 6 * k)) & 63] : '=';
+  }
+  return out;
+}
+
+template <class T>
+std::string bytes_of(const std::vector<T>& v, bool big_endian = false) {
+  std::string out;
+  for (const T& x : v) {
+    char b[sizeof(T)];
+    std::memcpy(b, &x, sizeof(T));
+    if (big_endian) std::reverse(b, b + sizeof(T));
+    out.append(b, sizeof(T));
+  }
+  return out;
+}
+
+// Two particles, every optional field in the layout a 3D code writes.
+const char* kPolyData = R"(<?xml version="1.0"?>
+<VTKFile type="PolyData" version="1.0" byte_order="LittleEndian">
+<PolyData>
+<FieldData><DataArray type="Float64" Name="TimeValue" NumberOfTuples="1" format="ascii">0.4999</DataArray></FieldData>
+<Piece NumberOfPoints="2" NumberOfVerts="0">
+<Points><DataArray type="Float32" NumberOfComponents="3" format="ascii">1.5 2.5 0  3.5 4.5 7</DataArray></Points>
+<PointData>
+<DataArray type="Float64" Name="reference_position" NumberOfComponents="2" format="ascii">1 2 3 4</DataArray>
+<DataArray type="Int32" Name="reference_volume" format="ascii">2 5</DataArray>
+<DataArray type="Float64" Name="velocity" NumberOfComponents="3" format="ascii">0.1 0.2 0.3  0.4 0.5 0.6</DataArray>
+<DataArray type="Float64" Name="stress" NumberOfComponents="6" format="ascii">11 22 33 12 23 13  -11 -22 -33 -12 -23 -13</DataArray>
+<DataArray type="Float64" Name="deformation_gradient" NumberOfComponents="9" format="ascii">
+  1.1 1.2 1.3 2.1 2.2 2.3 3.1 3.2 3.3   5.1 5.2 5.3 6.1 6.2 6.3 7.1 7.2 7.3</DataArray>
+</PointData>
+</Piece>
+</PolyData>
+</VTKFile>
+)";
+
+TEST(VtkFile, ComponentsLandInTheirInPlaceEntries) {
+  const fs::path dir = folder("components");
+  write(dir / "particles_0.vtp", kPolyData);
+  const std::optional<OutputState> s = ParticleOutput(dir.string(), "vtk", {0.5}).read(0, 0);
+  ASSERT_TRUE(s);
+  ASSERT_EQ(s->P.size(), 2u);
+  EXPECT_EQ(s->time, 0.4999);  // TimeValue, within a hundredth of the gap
+  EXPECT_EQ(s->P.position[1].x(), 3.5);  // z dropped
+  EXPECT_EQ(s->P.position[1].y(), 4.5);
+  EXPECT_EQ(s->P.reference_position[1].y(), 4.0);
+  EXPECT_EQ(s->P.reference_volume[1], 5.0);  // an integer array read as numbers
+  EXPECT_EQ(s->P.velocity[0].y(), 0.2);
+  // VTK's symmetric order xx, yy, zz, xy, yz, xz.
+  EXPECT_EQ(s->P.stress[0](0, 0), 11.0);
+  EXPECT_EQ(s->P.stress[0](1, 1), 22.0);
+  EXPECT_EQ(s->P.stress[0](0, 1), 12.0);
+  EXPECT_EQ(s->P.stress[1](1, 0), -12.0);
+  // A full tensor row-major: F12 is the second value, F21 the fourth.
+  EXPECT_EQ(s->P.deformation_gradient[0](0, 1), 1.2);
+  EXPECT_EQ(s->P.deformation_gradient[0](1, 0), 2.1);
+  EXPECT_EQ(s->P.deformation_gradient[1](1, 1), 6.2);
+  EXPECT_TRUE(s->fields.stress && s->fields.deformation_gradient && s->fields.velocity);
+  EXPECT_FALSE(s->fields.mass || s->fields.volume || s->fields.J);
+}
+
+TEST(VtkFile, Base64HeaderAndDataReadTheSameJoinedOrApart) {
+  // VTK encodes an inline binary array's header and data as two runs (each
+  // padded); other writers encode them as one.
+  const std::vector<double> values = {0.125, -3.0, 1e-300, 7.0, 2.5, 1.0 / 3.0};
+  const std::string data = bytes_of(values);
+  const std::string header = bytes_of(std::vector<std::uint32_t>{std::uint32_t(data.size())});
+  for (const std::string& encoded : {base64(header) + base64(data), base64(header + data)}) {
+    const fs::path path = folder("base64") / "p.vtu";
+    write(path, "<VTKFile type=\"UnstructuredGrid\" byte_order=\"LittleEndian\"><UnstructuredGrid>"
+                "<Piece NumberOfPoints=\"2\"><Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" "
+                "format=\"binary\">\n  " + encoded + "\n</DataArray></Points></Piece></UnstructuredGrid></VTKFile>");
+    const auto v = read_vtk_points(path.string());
+    EXPECT_EQ(v.points.values, values) << encoded;
+  }
+}
+
+TEST(VtkFile, LegacyBinaryIsBigEndianWithTheOldCellLayout) {
+  std::string text = "# vtk DataFile Version 3.0\nparticles\nBINARY\nDATASET UNSTRUCTURED_GRID\n";
+  text += "POINTS 2 float\n" + bytes_of(std::vector<float>{1, 2, 0, 3, 4, 0}, true) + "\n";
+  text += "CELLS 2 4\n" + bytes_of(std::vector<std::int32_t>{1, 0, 1, 1}, true) + "\n";
+  text += "CELL_TYPES 2\n" + bytes_of(std::vector<std::int32_t>{1, 1}, true) + "\n";
+  text += "CELL_DATA 2\nSCALARS dropped int 1\nLOOKUP_TABLE default\n" +
+          bytes_of(std::vector<std::int32_t>{9, 9}, true) + "\n";
+  text += "POINT_DATA 2\nSCALARS reference_volume double 1\nLOOKUP_TABLE default\n" +
+          bytes_of(std::vector<double>{0.25, 0.75}, true) + "\n";
+  text += "TENSORS stress double\n" +
+          bytes_of(std::vector<double>{1, 2, 0, 2, 3, 0, 0, 0, 9, 4, 5, 0, 5, 6, 0, 0, 0, 9}, true) + "\n";
+  const fs::path path = folder("legacy") / "p.vtk";
+  write(path, text);
+  const auto v = read_vtk_points(path.string());
+  EXPECT_EQ(v.points.values, (std::vector<double>{1, 2, 0, 3, 4, 0}));
+  ASSERT_EQ(v.point_data.count("reference_volume"), 1u);
+  EXPECT_EQ(v.point_data.at("reference_volume").values, (std::vector<double>{0.25, 0.75}));
+  EXPECT_EQ(v.point_data.at("stress").components, 9u);
+  EXPECT_EQ(v.point_data.at("stress").values[12], 5.0);
+  EXPECT_EQ(v.point_data.count("dropped"), 0u);  // cell data is read past
+}
+
+// The message of what read_vtk_points refuses.
+std::string refusal(const std::string& name, const std::string& text) {
+  const fs::path path = folder("refused") / name;
+  write(path, text);
+  try {
+    read_vtk_points(path.string());
+  } catch (const VtkFileError& e) {
+    return e.what();
+  }
+  return "(read)";
+}
+
+TEST(VtkFile, WhatCannotBeReadIsNamed) {
+  const std::string open = "<VTKFile type=\"UnstructuredGrid\"";
+  const std::string piece = "><UnstructuredGrid><Piece NumberOfPoints=\"1\"><Points>";
+  EXPECT_NE(refusal("a.vtu", open + " compressor=\"vtkLZ4DataCompressor\"" + piece +
+                                 "</Points></Piece></UnstructuredGrid></VTKFile>")
+                .find("compressor 'vtkLZ4DataCompressor'"),
+            std::string::npos);
+  EXPECT_NE(refusal("b.vtu", open + piece + "<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"appended\" "
+                                           "offset=\"0\"/></Points></Piece></UnstructuredGrid><AppendedData "
+                                           "encoding=\"raw\">_" + std::string("\x08\x00\x00\x00\x01\x02", 6) +
+                                           "</AppendedData></VTKFile>")
+                .find("the data end before 8 more bytes"),
+            std::string::npos);
+  EXPECT_NE(refusal("c.vtu", open + piece + "<DataArray type=\"Float64\" NumberOfComponents=\"2\" format=\"ascii\">1 2"
+                                           "</DataArray></Points></Piece></UnstructuredGrid></VTKFile>")
+                .find("Points must be 1 x 3"),
+            std::string::npos);
+  EXPECT_NE(refusal("d.vtu", "<VTKFile type=\"ImageData\"></VTKFile>").find("type 'ImageData'"), std::string::npos);
+  EXPECT_NE(refusal("e.vtk", "# vtk DataFile Version 3.0\nt\nASCII\nDATASET STRUCTURED_POINTS\n").find("STRUCTURED_POINTS"),
+            std::string::npos);
+  EXPECT_NE(refusal("f.vtk", "# vtk DataFile Version 3.0\nt\nASCII\nDATASET POLYDATA\nPOINTS 2 double\n1 2 3 4 x 6\n")
+                .find("'x' is not a number"),
+            std::string::npos);
+  EXPECT_NE(refusal("g.txt", "").find("not a .vtu, .vtp or .vtk file"), std::string::npos);
+  // A vector of 5 components is no vector of the plane.
+  const fs::path dir = folder("width");
+  std::string bad = kPolyData;
+  const std::string three = "Name=\"velocity\" NumberOfComponents=\"3\"";
+  bad.replace(bad.find(three), three.size(), "Name=\"velocity\" NumberOfComponents=\"2\"");
+  write(dir / "particles_0.vtp", bad);
+  try {
+    ParticleOutput(dir.string(), "vtk", {0.5}).read(0, 0);
+    ADD_FAILURE() << "a 3-tuple velocity read as 2 x 3";
+  } catch (const ParticleOutputError& e) {
+    EXPECT_NE(std::string(e.what()).find("point array 'velocity' has 3 tuples for 2 points"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
