@@ -83,20 +83,20 @@ void fill_state(OutputState& s, const ArraySource& source, const std::string& wh
                                             source.spelled("reference_volume")));
     return std::move(*a);
   };
-  const ArraySource::Rows X = required("reference_position", 2);
-  const std::size_t n = X.rows;
+  ArraySource::Rows reference = required("reference_position", 2);
+  const std::size_t n = reference.rows;
   auto checked = [&](const char* name, ArraySource::Rows a, std::size_t width) {
     if (a.rows != n || a.values.size() != n * width)
       throw ParticleOutputError(fmt::format("{}: {} must have {} rows of {} values ({} particles in {})", where,
                                             source.spelled(name), n, width, n, source.spelled("reference_position")));
     return std::move(a.values);
   };
-  if (X.values.size() != n * 2) checked("reference_position", X, 2);
+  const std::vector<double> X = checked("reference_position", std::move(reference), 2);
   const std::vector<double> x = checked("position", required("position", 2), 2);
   const std::vector<double> V0 = checked("reference_volume", required("reference_volume", 1), 1);
   start_state(s, n);
   for (std::size_t p = 0; p < n; ++p) {
-    s.P.reference_position[p] = Vec2(X.values[2 * p], X.values[2 * p + 1]);
+    s.P.reference_position[p] = Vec2(X[2 * p], X[2 * p + 1]);
     s.P.position[p] = Vec2(x[2 * p], x[2 * p + 1]);
     s.P.reference_volume[p] = V0[p];
   }

@@ -1,6 +1,7 @@
 #include "vtk_file.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cctype>
 #include <cstdint>
 #include <cstdlib>
@@ -31,34 +32,27 @@ struct ValueType {
   std::size_t size = 8;
 };
 
+// A value of type T from its bytes in host order.
+template <class T>
+double load(const unsigned char* b) {
+  T v;
+  std::memcpy(&v, b, sizeof(T));
+  return double(v);
+}
+
 // The bytes of one value, in the file's byte order, as a double.
 double value_of(const char* bytes, ValueType t, bool big_endian) {
   unsigned char b[8];
   std::memcpy(b, bytes, t.size);
-  const bool host_big = false;  // x86-64, and every host mpmvv builds on, is little-endian
-  if (big_endian != host_big) std::reverse(b, b + t.size);
-  switch (t.kind) {
-    case ValueType::floating:
-      if (t.size == 4) { float v; std::memcpy(&v, b, 4); return v; }
-      { double v; std::memcpy(&v, b, 8); return v; }
-    case ValueType::signed_integer: {
-      std::int64_t v = 0;
-      if (t.size == 1) { std::int8_t x; std::memcpy(&x, b, 1); v = x; }
-      else if (t.size == 2) { std::int16_t x; std::memcpy(&x, b, 2); v = x; }
-      else if (t.size == 4) { std::int32_t x; std::memcpy(&x, b, 4); v = x; }
-      else std::memcpy(&v, b, 8);
-      return double(v);
-    }
-    case ValueType::unsigned_integer: {
-      std::uint64_t v = 0;
-      if (t.size == 1) { std::uint8_t x; std::memcpy(&x, b, 1); v = x; }
-      else if (t.size == 2) { std::uint16_t x; std::memcpy(&x, b, 2); v = x; }
-      else if (t.size == 4) { std::uint32_t x; std::memcpy(&x, b, 4); v = x; }
-      else std::memcpy(&v, b, 8);
-      return double(v);
-    }
+  if (big_endian != (std::endian::native == std::endian::big)) std::reverse(b, b + t.size);
+  const bool is_signed = t.kind == ValueType::signed_integer;
+  if (t.kind == ValueType::floating) return t.size == 4 ? load<float>(b) : load<double>(b);
+  switch (t.size) {
+    case 1: return is_signed ? load<std::int8_t>(b) : load<std::uint8_t>(b);
+    case 2: return is_signed ? load<std::int16_t>(b) : load<std::uint16_t>(b);
+    case 4: return is_signed ? load<std::int32_t>(b) : load<std::uint32_t>(b);
+    default: return is_signed ? load<std::int64_t>(b) : load<std::uint64_t>(b);
   }
-  return 0.0;
 }
 
 std::vector<double> values_of(const std::string& bytes, ValueType t, bool big_endian) {
