@@ -50,7 +50,17 @@ Divided by the exact signal S the norm measures at the read time (the mean
 is the smallest relative error E / S an order can be observed from. It is a
 worst case (independent roundings mostly cancel, leaving nearer sqrt(n) ulps
 than n): an error above it is not this rounding; one at or below it may be, and an
-order fitted through it is no evidence of how the method converges. For a
+order fitted through it is no evidence of how the method converges. A run by another
+program (external_command) is read from the numbers it wrote, each rounded to the
+spacing s of how it wrote them (the /external attribute output_spacing: 2.2e-16
+for doubles, 1.2e-7 for floats, 10^(1-d) for text of d significant digits; the
+coarsest of the arrays the norms difference). Its floor adds
+
+    OUTPUT_SPACING_UNITS s M,     OUTPUT_SPACING_UNITS = 4:
+
+a displacement error x - phi(X, t) of a written x and a written X is off by half a
+spacing of |x| and |F| half spacings of |X|, at most 2 s M for |F| <= 3; 4 doubles
+that, and F - I of an F written near 1 is off by half a spacing of 1, within it. For a
 relative error M = 1, but a strain formed as F - I near F = I (and a stress
 formed from it) is rounded to ulps of 1, not of the strain: for the error_*
 columns of a strain or stress M = 1 / |strain|, the largest |F - I| entry
@@ -88,6 +98,9 @@ GCI_SAFETY_FACTOR = 1.25
 # the steps (the exact solution's elementary functions, the difference, the
 # norm): "a few hundred", generous, so that the floor is a worst case.
 ROUNDOFF_ULPS = 256
+# Spacings of an external program's written numbers its rounding may leave in an
+# error (module docstring): a worst case, like ROUNDOFF_ULPS.
+OUTPUT_SPACING_UNITS = 4
 
 
 def pairwise_orders(h, error):
@@ -133,10 +146,13 @@ def least_squares_order(h, error, confidence=0.95):
     return OrderFit(slope, math.exp(fit.intercept), slope - half_width, slope + half_width, confidence, n)
 
 
-def roundoff_floor(steps, size):
-    """(ROUNDOFF_ULPS + steps) eps size: the largest error rounding alone can leave
-    in a difference of numbers of the given size after that many steps (module docstring)."""
-    return (ROUNDOFF_ULPS + max(steps, 0)) * sys.float_info.epsilon * size
+def roundoff_floor(steps, size, output_spacing=0.0):
+    """(ROUNDOFF_ULPS + steps) eps size + OUTPUT_SPACING_UNITS output_spacing size:
+    the largest error rounding alone can leave in a difference of numbers of the
+    given size after that many steps, read from numbers written to the relative
+    spacing output_spacing (0 for mpmvv's own run; module docstring)."""
+    return ((ROUNDOFF_ULPS + max(steps, 0)) * sys.float_info.epsilon
+            + OUTPUT_SPACING_UNITS * max(output_spacing, 0.0)) * size
 
 
 def classify(pairwise, floor=None):

@@ -10,8 +10,8 @@ import numpy as np
 from . import norms
 from . import orders
 from .probes import read_point_history, read_probe_lines
-from .series import (DEFAULT_REFINE_KEY, floor_kind, refined_size, refinement_series, roundoff_checks, series_levels,
-                    steps_of, usable)
+from .series import (DEFAULT_REFINE_KEY, case_roundoff_floor, floor_kind, refined_size, refinement_series,
+                     roundoff_checks, series_levels, usable)
 
 
 # orders.csv: one row per (study, refinement series, norm, time), one value
@@ -48,8 +48,8 @@ LEVELS_CSV_COLUMNS = (
                            "and at round-off)"),
     ("relative_error", "the error over the exact signal the norm measures at that time (NaN where not known; "
                        "error_* and particle_relative_L2_integrated are relative already: signal 1)"),
-    ("roundoff_floor", "the round-off floor, (256 + steps) ulps of the numbers the error is a difference of, over "
-                       "the same signal: a level whose relative_error is at most this is at round-off "
+    ("roundoff_floor", "the round-off floor, (256 + steps) ulps of the numbers the error is a difference of (and "
+                       "4 spacings of how an external program wrote them), over the same signal: a level whose relative_error is at most this is at round-off "
                        "(reports/orders.py)"),
     ("settling", "the settling level over the same signal, the largest error the run's distance from its static "
                  "state at the end could leave (scales.py: settling_scale; NaN for a run that does not settle): a "
@@ -203,7 +203,7 @@ def gci_row(series):
 def point_changes_at_roundoff(cases, history, values):
     """True when a change of the point's value between consecutive levels is no
     larger than the round-off floor of reports/orders.py (the point's |X| for a
-    length, pi for an angle, over the most steps any of the cases took): such
+    length, pi for an angle, for the worst of the cases: series.case_roundoff_floor): such
     changes measure rounding, and Roache's order of them means nothing."""
     position = np.ravel(np.asarray(history.reference_position, float))
     if history.quantity == "angular_displacement":
@@ -212,7 +212,7 @@ def point_changes_at_roundoff(cases, history, values):
         size = float(np.hypot(position[0], position[1]))
     else:
         return False
-    floor = orders.roundoff_floor(max((steps_of(c) for c in cases), default=0), size)
+    floor = case_roundoff_floor(cases, size)
     return any(abs(coarse - fine) <= floor for coarse, fine in zip(values, values[1:]))
 
 

@@ -12,7 +12,7 @@ lost (the results file's health verdict, reports/results-format.md), and it
 counts as not completed everywhere. A case without a readable results file (pending, crashed, timeout,
 error, or a damaged file) is kept with ``results = None`` and a note saying why,
 so that every report and the gate can show it instead of stopping on it.
-Only root attributes, /errors and the /measurements and /settling scalars are read up front;
+Only root attributes, /errors and the /measurements, /settling and /external scalars are read up front;
 probe arrays (lines, points, the circle, /probes/contact_pressure,
 /probes/history, /probes/monitors) are read on demand for the cases that are
 plotted (probes.py), and the scales an error is judged against are in
@@ -45,6 +45,7 @@ class CaseResults:
     line_quantities: dict         # probe line name -> its 'quantity' attribute
     measurements: dict = field(default_factory=dict)   # /measurements attributes: name -> value
     settling: dict = field(default_factory=dict)       # /settling attributes, its norms under "norms"
+    external: dict = field(default_factory=dict)       # /external attributes (another program's run)
 
 
 @dataclass(frozen=True)
@@ -219,8 +220,8 @@ def plain(value):
 
 
 def read_case_results(path):
-    """Root attributes, /errors, the probe lines' quantities and the /measurements
-    and /settling attributes of one results file."""
+    """Root attributes, /errors, the probe lines' quantities and the /measurements,
+    /settling and /external attributes of one results file."""
     with h5py.File(path, "r") as f:
         attributes = {name: plain(value) for name, value in f.attrs.items()}
         errors_group = f.get("errors")
@@ -248,7 +249,10 @@ def read_case_results(path):
             norms_group = settling_group.get("norms")
             settling["norms"] = ({name: plain(value) for name, value in norms_group.attrs.items()}
                                  if isinstance(norms_group, h5py.Group) else {})
-    return CaseResults(attributes, error_times, errors, line_quantities, measurements, settling)
+        external_group = f.get("external")
+        external = ({name: plain(value) for name, value in external_group.attrs.items()}
+                    if isinstance(external_group, h5py.Group) else {})
+    return CaseResults(attributes, error_times, errors, line_quantities, measurements, settling, external)
 
 
 def lookup_error(case, norm, time):

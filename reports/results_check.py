@@ -172,6 +172,10 @@ def check_external(f, problems):
     for name in ("command", "command_template", "format", "ended", "exit_status", "fields", "J_rule"):
         if name not in group.attrs:
             problems.append(f"/external/@{name}: missing")
+    # Files ingested before output_spacing was written lack it: the floor then counts doubles.
+    spacing = group.attrs.get("output_spacing")
+    if spacing is not None and not (isinstance(spacing, (float, np.floating)) and 0.0 <= spacing < 1.0):
+        problems.append(f"/external/@output_spacing: {spacing!r} is not a relative spacing in [0, 1)")
     if "output_time" not in group:
         problems.append("/external/output_time: missing")
     elif "errors" in f and "time" in f["errors"] and group["output_time"].shape != f["errors"]["time"].shape:

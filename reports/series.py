@@ -188,7 +188,7 @@ class RoundOff:
     that state at the end can leave (scales.settling_scale; None otherwise)."""
     level: Level
     signal: float         # S, in the norm's unit (1 for an error relative to its exact value; NaN: not known)
-    floor: float          # orders.roundoff_floor(the case's steps, M)
+    floor: float          # case_roundoff_floor([the case], M)
     settling: float = None
 
     def _relative(self, value):
@@ -235,7 +235,7 @@ def roundoff_checks(levels, norm, time=None):
         at = case.end_time if time is None else float(time)
         scale, settling = error_scale(case, norm, at), settling_scale(case, norm, at)
         if scale is not None:
-            checks.append(RoundOff(level, scale[0], roundoff_floor(steps_of(case), scale[1]), settling))
+            checks.append(RoundOff(level, scale[0], case_roundoff_floor([case], scale[1]), settling))
         elif settling is not None:
             checks.append(RoundOff(level, float("nan"), 0.0, settling))
         else:
@@ -247,6 +247,20 @@ def steps_of(case):
     """The steps the case's run took (its attribute `steps`), 0 where not known."""
     steps = case.attribute("steps", 0)
     return int(steps) if isinstance(steps, (int, float)) and math.isfinite(steps) else 0
+
+
+def output_spacing_of(case):
+    """The relative spacing of the numbers another program wrote for the case
+    (/external attribute output_spacing, reports/orders.py), 0 for mpmvv's own run."""
+    spacing = case.results.external.get("output_spacing", 0.0) if case.results is not None else 0.0
+    return float(spacing) if isinstance(spacing, (int, float)) and math.isfinite(spacing) else 0.0
+
+
+def case_roundoff_floor(cases, size):
+    """orders.roundoff_floor of numbers of `size` for the worst of `cases`: the
+    most steps any took, the coarsest spacing any external program wrote with."""
+    return roundoff_floor(max((steps_of(c) for c in cases), default=0), size,
+                          max((output_spacing_of(c) for c in cases), default=0.0))
 
 
 def pair_order_cell(cases, norm, time, errors, sizes, width=9):

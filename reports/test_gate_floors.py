@@ -15,7 +15,7 @@ from .conftest import (RING_TIMES, ROUNDOFF_SUITE, SYNTHETIC_SUITE, roundoff_cas
                       write_suite_directory)
 from .results import read_suite
 from .scales import error_scale, settling_scale
-from .series import Level, RoundOff, error_floor_kind, refinement_series, series_levels
+from .series import Level, RoundOff, error_floor_kind, refinement_series, roundoff_checks, series_levels
 from .test_gate import rows_of, run_gate
 
 NOISY_SUITE = """description = "synthetic: cpdi errors 0.5 h^2 times 1, 1.3, 0.8, 1.2 on 32-256 cells"
@@ -331,3 +331,33 @@ def test_a_fit_on_fewer_levels_than_the_figure_says_which(tmp_path, capsys):
     directory = write_suite_directory(tmp_path / "all", SYNTHETIC_SUITE, synthetic_ring_cases())
     _, out, _ = run_gate(directory, capsys)
     assert "fitted on" not in out
+
+
+def test_an_external_programs_written_digits_raise_the_floor(tmp_path):
+    """Requirement: the round-off floor of a run another program wrote counts how
+    finely it wrote its numbers (/external output_spacing, reports/orders.py):
+    on a body 1 m across, 6 significant digits (spacing 1e-5) put a 1e-5 m
+    particle_L2 error at round-off (floor 4 spacings: 4e-5 m), where doubles'
+    spacing leaves the floor of mpmvv's own runs (256 + 100 ulps: 7.9e-14 m) and
+    the same error is the method's."""
+    cases = []
+    for cells in (8, 16, 32):
+        keys = {"method": "cpdi", "cells": cells, "end_time": 1.0, "output_times": RING_TIMES}
+        errors = {"particle_L2": [1e-5] * 3, "exact_displacement_L2": [0.1] * 3}
+        cases.append({"id": f"theirs-cells={cells}", "study": "theirs", "keys": keys, "status": "completed",
+                      "h": 1.0 / cells, "times": RING_TIMES, "errors": errors,
+                      "particle_positions": [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [0.6, 0.8]]})
+    directory = write_suite_directory(tmp_path / "suite",
+                                      "[[study]]\nname = \"theirs\"\nscene = \"scenes/ring.toml\"\n", cases)
+    for cells, spacing in ((8, 1e-5), (16, 2.220446049250313e-16)):
+        with h5py.File(directory / "cases" / f"theirs-cells={cells}.h5", "a") as f:
+            f.create_group("external").attrs["output_spacing"] = spacing
+    by_id = {c.id: c for c in read_suite(directory).cases}
+    [six_digits] = roundoff_checks([Level(by_id["theirs-cells=8"], None, 1.0 / 8, 1e-5, "")], "particle_L2")
+    assert six_digits.floor == pytest.approx((356 * 2.220446049250313e-16 + 4e-5) * 1.0, rel=1e-12)
+    assert error_floor_kind(by_id["theirs-cells=8"], "particle_L2", 1.0, 1e-5) == "round-off"
+    assert error_floor_kind(by_id["theirs-cells=8"], "particle_L2", 1.0, 1e-3) is None
+    for doubles in ("theirs-cells=16", "theirs-cells=32"):  # written as doubles; no /external at all
+        [check] = roundoff_checks([Level(by_id[doubles], None, 1.0 / 16, 1e-5, "")], "particle_L2")
+        assert check.floor < 4 * 356 * 2.220446049250313e-16
+        assert error_floor_kind(by_id[doubles], "particle_L2", 1.0, 1e-5) is None

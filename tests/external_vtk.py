@@ -18,8 +18,9 @@ component shows), and writes them:
   the time as field data.
 
 Every binary layout gives /errors and /particles equal to the CSV's bit for
-bit; the 12-digit ascii one within 1e-9. A missing required array and two
-files for one output time are named.
+bit; the 12-digit ascii one within 1e-9, its output_spacing 1e-11 (the
+doubles' 2.2e-16). A missing required array, particles moved out of the
+plane and two files for one output time are named.
 
     /usr/bin/python3 tests/external_vtk.py MPMVV   (ctest runs it; exit 1 names what failed)
 """
@@ -74,9 +75,10 @@ def xyz(a2):
     return np.c_[a2, np.zeros(len(a2))]
 
 
-def full(t2):  # N x 2 x 2 -> N x 9, the plane's entries in a 3 x 3
+def full(t2, zz=0.0):  # N x 2 x 2 -> N x 9, the plane's entries in a 3 x 3 (F: zz = F_33 = 1)
     f = np.zeros((len(t2), 3, 3))
     f[:, :2, :2] = t2
+    f[:, 2, 2] = zz
     return f.reshape(-1, 9)
 
 
@@ -178,8 +180,11 @@ for k, t_out in enumerate(inp["output_times"]):
     elif mode == "vtp":
         S6 = np.c_[S[:, 0, 0], S[:, 1, 1], np.zeros(N), S[:, 0, 1], np.zeros(N), np.zeros(N)]
         arrays = [("reference_position", xyz(np.c_[X, Y])), ("reference_volume", V0), ("velocity", vel),
-                  ("stress", S6), ("deformation_gradient", full(F)), ("volume", V)]
-        write_xml(path("particles", k, "vtp"), "PolyData", xyz(x), arrays, t, "UInt64", False, False)
+                  ("stress", S6), ("deformation_gradient", full(F, 1.0)), ("volume", V)]
+        points = xyz(x)
+        if "bent" in sys.argv[3:]:  # a 3-D code's motion out of the plane
+            points[:, 2] = 1e-3 * X * t
+        write_xml(path("particles", k, "vtp"), "PolyData", points, arrays, t, "UInt64", False, False)
         write_xml(path("tracers", k, "vtp"), "PolyData", xyz(tx), [], t, "UInt64", False, False)
     elif mode == "vtu-base64":
         arrays = [("reference_position", np.c_[X, Y]), ("reference_volume", V0), ("velocity", xyz(vel)),
@@ -190,7 +195,7 @@ for k, t_out in enumerate(inp["output_times"]):
         write_legacy_ascii(path("particles", k, "vtk"), xyz(x), t,
                            scalars=[("reference_volume", V0), ("volume", V)],
                            vectors=[("reference_position", xyz(np.c_[X, Y])), ("velocity", xyz(vel))],
-                           tensors=[("stress", full(S)), ("deformation_gradient", full(F))])
+                           tensors=[("stress", full(S)), ("deformation_gradient", full(F, 1.0))])
         write_legacy_ascii(path("tracers", k, "vtk"), xyz(tx), t)
 '''
 
@@ -241,6 +246,12 @@ with tempfile.TemporaryDirectory() as tmp:
             check(False, f"{mode}: exit {r.returncode}: {r.stdout}{r.stderr}")
             continue
         got = datasets(path)
+        # How finely the numbers were written: doubles, or meshio's 12 ascii digits.
+        with h5py.File(path) as f:
+            spacing = f["external"].attrs.get("output_spacing")
+        want_spacing = 1e-11 if mode == "meshio-vtu-ascii" else np.finfo(float).eps
+        check(spacing is not None and np.isclose(spacing, want_spacing, rtol=1e-12, atol=0),
+              f"{mode}: /external output_spacing {spacing}, not {want_spacing}")
         check(sorted(got) == sorted(reference), f"{mode}: datasets {sorted(got)} against {sorted(reference)}")
         for name, want in reference.items():
             if name not in got:
@@ -260,6 +271,9 @@ with tempfile.TemporaryDirectory() as tmp:
     if path.exists():
         with h5py.File(path) as f:
             check(len(f["errors"]["time"]) == 1, "the output read before the malformed one is kept")
+    r, _ = run(tmp, "bent", "vtk", "vtp", "bent")
+    check(r.returncode == 1 and "malformed output" in r.stdout and "the points is not plane strain: z - Z" in r.stdout,
+          f"particles moved out of the plane: {r.stdout}")
     r, _ = run(tmp, "twice", "vtk", "meshio-vtu-binary", "ontime", "twice")
     check(r.returncode == 1 and "particles_0.vtu and" in r.stdout and "one file per output time" in r.stdout,
           f"two files for one output: {r.stdout}")

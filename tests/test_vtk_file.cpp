@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -14,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "tools/app/scene/number_spacing.hpp"
 #include "tools/app/scene/particle_output.hpp"
 #include "tools/app/scene/vtk_file.hpp"
 
@@ -25,6 +27,7 @@ using mpmvv::app::ParticleOutput;
 using mpmvv::app::ParticleOutputError;
 using mpmvv::app::read_vtk_points;
 using mpmvv::app::VtkFileError;
+namespace app = mpmvv::app;
 
 fs::path folder(const std::string& name) {
   const fs::path dir = fs::temp_directory_path() / "mpmvv-vtk-test" / name;
@@ -62,7 +65,9 @@ std::string bytes_of(const std::vector<T>& v, bool big_endian = false) {
   return out;
 }
 
-// Two particles, every optional field in the layout a 3D code writes.
+// Two particles, every optional field in the layout a 3D code writes, in the
+// plane (the third components of velocity, F and stress vanish; the points'
+// z, 0 and 7, is free: reference_position has 2 components).
 const char* kPolyData = R"(<?xml version="1.0"?>
 <VTKFile type="PolyData" version="1.0" byte_order="LittleEndian">
 <PolyData>
@@ -72,10 +77,10 @@ const char* kPolyData = R"(<?xml version="1.0"?>
 <PointData>
 <DataArray type="Float64" Name="reference_position" NumberOfComponents="2" format="ascii">1 2 3 4</DataArray>
 <DataArray type="Int32" Name="reference_volume" format="ascii">2 5</DataArray>
-<DataArray type="Float64" Name="velocity" NumberOfComponents="3" format="ascii">0.1 0.2 0.3  0.4 0.5 0.6</DataArray>
-<DataArray type="Float64" Name="stress" NumberOfComponents="6" format="ascii">11 22 33 12 23 13  -11 -22 -33 -12 -23 -13</DataArray>
+<DataArray type="Float64" Name="velocity" NumberOfComponents="3" format="ascii">0.1 0.2 0  0.4 0.5 0</DataArray>
+<DataArray type="Float64" Name="stress" NumberOfComponents="6" format="ascii">11 22 33 12 0 0  -11 -22 -33 -12 0 0</DataArray>
 <DataArray type="Float64" Name="deformation_gradient" NumberOfComponents="9" format="ascii">
-  1.1 1.2 1.3 2.1 2.2 2.3 3.1 3.2 3.3   5.1 5.2 5.3 6.1 6.2 6.3 7.1 7.2 7.3</DataArray>
+  1.1 1.2 0 2.1 2.2 0 0 0 1   5.1 5.2 0 6.1 6.2 0 0 0 1</DataArray>
 </PointData>
 </Piece>
 </PolyData>
@@ -193,6 +198,95 @@ TEST(VtkFile, WhatCannotBeReadIsNamed) {
   } catch (const ParticleOutputError& e) {
     EXPECT_NE(std::string(e.what()).find("point array 'velocity' has 3 tuples for 2 points"), std::string::npos) << e.what();
   }
+}
+
+TEST(NumberSpacing, DigitsAsWrittenAndTypesAsStored) {
+  EXPECT_EQ(app::significant_digits("-1.25000e-3"), 6);  // trailing zeros are written precision
+  EXPECT_EQ(app::significant_digits("0.000120"), 3);     // leading zeros are not
+  EXPECT_EQ(app::significant_digits("7"), 1);
+  EXPECT_EQ(app::significant_digits("+12.5E+07"), 3);
+  EXPECT_EQ(app::significant_digits("0.00"), 0);
+  EXPECT_DOUBLE_EQ(app::digits_spacing(6), 1e-5);
+  EXPECT_DOUBLE_EQ(app::digits_spacing(12), 1e-11);
+  EXPECT_EQ(app::digits_spacing(17), app::kDoubleSpacing);  // 1e-16 is finer than a double
+  EXPECT_EQ(app::digits_spacing(0), app::kDoubleSpacing);   // every number was zero
+  EXPECT_EQ(app::binary_spacing(true, 8, {}), app::kDoubleSpacing);
+  EXPECT_EQ(app::binary_spacing(true, 4, {}), std::ldexp(1.0, -23));
+  EXPECT_EQ(app::binary_spacing(false, 4, {3.0, -250.0, 4.0}), 1.0 / 250.0);
+  EXPECT_EQ(app::binary_spacing(false, 2, {0.0}), 1.0);
+}
+
+TEST(VtkFile, ArraysKeepTheSpacingTheyWereWrittenWith) {
+  const fs::path dir = folder("spacing");
+  write(dir / "particles_0.vtp", kPolyData);
+  const auto v = read_vtk_points((dir / "particles_0.vtp").string());
+  EXPECT_DOUBLE_EQ(v.points.spacing, 0.1);                       // "1.5": 2 digits
+  EXPECT_DOUBLE_EQ(v.point_data.at("reference_volume").spacing, 1.0);  // "2", "5": one digit
+  // The state's spacing is the coarsest of what the norms difference
+  // (positions, velocity, stress, F; not the volumes): the velocity's "0.1",
+  // one digit, 1.
+  const std::optional<OutputState> s = ParticleOutput(dir.string(), "vtk", {0.5}).read(0, 0);
+  ASSERT_TRUE(s);
+  EXPECT_DOUBLE_EQ(s->output_spacing, 1.0);
+}
+
+// What read() says of `text` as an output's particles file `name`; "(read)" when it reads.
+std::string read_message(const std::string& name, const std::string& text) {
+  const fs::path dir = folder("plane");
+  write(dir / name, text);
+  try {
+    ParticleOutput(dir.string(), "vtk", {0.5}).read(0, 0);
+  } catch (const ParticleOutputError& e) {
+    return e.what();
+  }
+  return "(read)";
+}
+
+// kPolyData with the first occurrence of `from` replaced by `to`.
+std::string changed(const std::string& from, const std::string& to) {
+  std::string text = kPolyData;
+  const std::size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return at == std::string::npos ? text : text.replace(at, from.size(), to);
+}
+
+TEST(VtkFile, OnlyThePlaneIsRead) {
+  const auto refused = [](const std::string& message, const std::string& what) {
+    const bool found = message.find("is not plane strain: " + what) != std::string::npos;
+    if (!found) ADD_FAILURE() << message;
+    return found;
+  };
+  // Each third component that does not vanish is named; each array written
+  // here with 6 digits (spacing 1e-5: tolerance 8e-5 of its largest in-plane
+  // magnitude; kPolyData's 1 and 2 digits would resolve nothing).
+  EXPECT_TRUE(refused(read_message("particles_0.vtp", changed("0.4 0.5 0<", "0.4 0.5 0.0100000<")),
+                      "v_z is 0.01 at particle 1"));
+  EXPECT_TRUE(refused(read_message("particles_0.vtp", changed("11 22 33 12 0 0", "11 22 33 12 0 1.00000")),
+                      "sigma_xz is 1"));
+  EXPECT_TRUE(refused(read_message("particles_0.vtp", changed("11 22 33 12 0 0", "11 22 33 12 2.00000 0")),
+                      "sigma_yz is 2"));
+  EXPECT_TRUE(refused(read_message("particles_0.vtp", changed("5.1 5.2 0 6.1 6.2 0 0 0 1", "5.1 5.2 0 6.1 6.2 0 0 0 1.10000")),
+                      "F_33 - 1 is 0.1"));
+  EXPECT_TRUE(refused(read_message("particles_0.vtp", changed("1.1 1.2 0 2.1", "1.1 1.2 0.200000 2.1")), "F_13 is 0.2"));
+  // A double's round-off out of the plane is no motion: within 1e-9.
+  EXPECT_EQ(read_message("particles_0.vtp", changed("6.2 0 0 0 1", "6.2 0 0 0 1.00000000001")), "(read)");
+  // A 3-component reference position: z must stay Z (a slab moved out of the
+  // plane as a whole is still plane strain; a bent one is not).
+  const std::string Z = changed("NumberOfComponents=\"2\" format=\"ascii\">1 2 3 4",
+                                "NumberOfComponents=\"3\" format=\"ascii\">1.00000 2 0 3 4 7");
+  EXPECT_EQ(read_message("particles_0.vtp", Z), "(read)");
+  std::string bent = Z;
+  bent.replace(bent.find("3.5 4.5 7"), 9, "3.5 4.5 7.50000");
+  EXPECT_TRUE(refused(read_message("particles_0.vtp", bent), "z - Z is 0.5 at particle 1"));
+  // Floats: 8 spacings (2^-23) of the largest in-plane magnitude pass, 1e-3 of it does not.
+  const auto floats = [](float vz) {
+    return changed("type=\"Float64\" Name=\"velocity\" NumberOfComponents=\"3\" format=\"ascii\">0.1 0.2 0  0.4 0.5 0",
+                   "type=\"Float32\" Name=\"velocity\" NumberOfComponents=\"3\" format=\"binary\">" +
+                       base64(bytes_of(std::vector<std::uint32_t>{24}) +
+                              bytes_of(std::vector<float>{0.1f, 0.2f, vz, 0.4f, 0.5f, 0.0f})));
+  };
+  EXPECT_EQ(read_message("particles_0.vtp", floats(1e-7f)), "(read)");
+  EXPECT_TRUE(refused(read_message("particles_0.vtp", floats(5e-4f)), "v_z is 0.0005"));
 }
 
 }  // namespace

@@ -282,6 +282,17 @@ std::vector<double> Group::read_doubles(const std::string& name, std::vector<hsi
   return data;
 }
 
+Group::StoredNumber Group::stored_number(const std::string& name) const {
+  const std::string what = join(path_, name);
+  Handle set(check(H5Dopen2(id(), name.c_str(), H5P_DEFAULT), "H5Dopen2", what), H5Dclose);
+  Handle type(check(H5Dget_type(set.get()), "H5Dget_type", what), H5Tclose);
+  const H5T_class_t kind = H5Tget_class(type.get());
+  if (kind == H5T_NO_CLASS) fail("H5Tget_class", what);
+  const std::size_t bytes = H5Tget_size(type.get());
+  if (bytes == 0) fail("H5Tget_size", what);
+  return {kind == H5T_FLOAT, bytes};
+}
+
 bool Group::is_group(const std::string& name) const {
   const std::string what = join(path_, name);
   Handle object(check(H5Oopen(id(), name.c_str(), H5P_DEFAULT), "H5Oopen", what), H5Oclose);

@@ -78,6 +78,12 @@ class Group {
   std::vector<double> read_doubles(const std::string& name, std::vector<hsize_t>* dims = nullptr) const;
   // A dataset's dimensions, without reading it.
   std::vector<hsize_t> dimensions(const std::string& name) const;
+  // How a dataset's numbers are stored: floating point or integer, and their size in bytes.
+  struct StoredNumber {
+    bool floating = true;
+    std::size_t bytes = 8;
+  };
+  StoredNumber stored_number(const std::string& name) const;
   // The length of a dataset of bytes, and its bytes into `out` (`size` of
   // them, which must be its length).
   std::size_t byte_count(const std::string& name) const;

@@ -110,6 +110,7 @@ class ExternalCase final : public SceneCase {
                       fmt::format("output {} holds {}; output 0 held {}", k, fields_text(state->fields),
                                   fields_text(fields_)));
       record(k, *state);
+      output_spacing_ = k == 0 ? state->output_spacing : std::max(output_spacing_, state->output_spacing);
       o.time_reached = loop_.output_times[k];
       o.outputs_written = k + 1;
       const bool finite = std::all_of(state->P.position.begin(), state->P.position.end(),
@@ -182,6 +183,8 @@ class ExternalCase final : public SceneCase {
     g.set_attribute("log_tail", end_.log_tail);
     g.set_attribute("fields", fields_text(fields_));
     g.set_attribute("J_rule", j_given() ? "applied" : "not applied: the program gave no F, J or volume");
+    // The report's round-off floor counts this rounding (reports/orders.py: OUTPUT_SPACING_UNITS).
+    g.set_attribute("output_spacing", output_spacing_);
     g.write("output_time", program_time_, {program_time_.size()});
   }
 
@@ -254,6 +257,7 @@ class ExternalCase final : public SceneCase {
   ErrorTable errors_;
   TimeIntegral integrated_;
   std::vector<double> j_ratio_, program_time_;
+  double output_spacing_ = 0.0;  // the coarsest of the outputs' (OutputState::output_spacing)
   std::vector<HealthSample> samples_;
   double motion_ = 0.0;
 };

@@ -9,9 +9,11 @@
 #include <limits>
 #include <map>
 #include <sstream>
+#include <string_view>
 
 #include <fmt/format.h>
 
+#include "number_spacing.hpp"
 #include "solver/io/hdf5.hpp"
 #include "vtk_file.hpp"
 
@@ -67,6 +69,7 @@ struct ArraySource {
   struct Rows {
     std::vector<double> values;
     std::size_t rows = 0;
+    double spacing = kDoubleSpacing;  // of the numbers as the file stores them
   };
   std::function<std::optional<Rows>(const std::string& name, std::size_t width)> get;
   std::function<std::string(const std::string& name)> spelled;
@@ -83,7 +86,14 @@ void fill_state(OutputState& s, const ArraySource& source, const std::string& wh
                                             source.spelled("reference_volume")));
     return std::move(*a);
   };
-  ArraySource::Rows reference = required("reference_position", 2);
+  // The coarsest spacing of the arrays the norms difference (positions, F,
+  // J, stress, velocity); volumes and masses only weight them.
+  double spacing = 0.0;
+  auto differenced = [&](ArraySource::Rows a) {
+    spacing = std::max(spacing, a.spacing);
+    return a;
+  };
+  ArraySource::Rows reference = differenced(required("reference_position", 2));
   const std::size_t n = reference.rows;
   auto checked = [&](const char* name, ArraySource::Rows a, std::size_t width) {
     if (a.rows != n || a.values.size() != n * width)
@@ -92,7 +102,7 @@ void fill_state(OutputState& s, const ArraySource& source, const std::string& wh
     return std::move(a.values);
   };
   const std::vector<double> X = checked("reference_position", std::move(reference), 2);
-  const std::vector<double> x = checked("position", required("position", 2), 2);
+  const std::vector<double> x = checked("position", differenced(required("position", 2)), 2);
   const std::vector<double> V0 = checked("reference_volume", required("reference_volume", 1), 1);
   start_state(s, n);
   for (std::size_t p = 0; p < n; ++p) {
@@ -100,11 +110,11 @@ void fill_state(OutputState& s, const ArraySource& source, const std::string& wh
     s.P.position[p] = Vec2(x[2 * p], x[2 * p + 1]);
     s.P.reference_volume[p] = V0[p];
   }
-  auto optional = [&](const char* name, std::size_t width, bool& given) -> std::vector<double> {
+  auto optional = [&](const char* name, std::size_t width, bool& given, bool weight = false) -> std::vector<double> {
     auto a = source.get(name, width);
     if (!a) return {};
     given = true;
-    return checked(name, std::move(*a), width);
+    return checked(name, weight ? std::move(*a) : differenced(std::move(*a)), width);
   };
   if (const auto v = optional("velocity", 2, s.fields.velocity); s.fields.velocity)
     for (std::size_t p = 0; p < n; ++p) s.P.velocity[p] = Vec2(v[2 * p], v[2 * p + 1]);
@@ -113,9 +123,10 @@ void fill_state(OutputState& s, const ArraySource& source, const std::string& wh
   if (const auto v = optional("deformation_gradient", 4, s.fields.deformation_gradient); s.fields.deformation_gradient)
     for (std::size_t p = 0; p < n; ++p)
       s.P.deformation_gradient[p] << v[4 * p], v[4 * p + 1], v[4 * p + 2], v[4 * p + 3];
-  if (auto v = optional("volume", 1, s.fields.volume); s.fields.volume) s.P.volume = std::move(v);
-  if (auto v = optional("mass", 1, s.fields.mass); s.fields.mass) s.P.mass = std::move(v);
+  if (auto v = optional("volume", 1, s.fields.volume, true); s.fields.volume) s.P.volume = std::move(v);
+  if (auto v = optional("mass", 1, s.fields.mass, true); s.fields.mass) s.P.mass = std::move(v);
   if (auto v = optional("J", 1, s.fields.J); s.fields.J) s.J = std::move(v);
+  s.output_spacing = spacing;
 }
 
 void check_tracers(std::size_t given, std::size_t tracers, const std::string& where) {
@@ -152,6 +163,8 @@ std::optional<OutputState> ParticleOutput::read_hdf5(std::size_t k, std::size_t 
     ArraySource::Rows a;
     a.values = g.read_doubles(dataset, &d);
     a.rows = d.empty() ? 0 : d[0];
+    const h5::Group::StoredNumber stored = g.stored_number(dataset);
+    a.spacing = binary_spacing(stored.floating, stored.bytes, a.values);
     return a;
   };
   source.spelled = [](const std::string& dataset) { return fmt::format("dataset '{}'", dataset); };
@@ -163,6 +176,8 @@ std::optional<OutputState> ParticleOutput::read_hdf5(std::size_t k, std::size_t 
     if (d.size() != 2 || d[0] != tracers || d[1] != 2)
       throw ParticleOutputError(fmt::format("{}/tracer_position: must be {} x 2 (the input file's tracers)", where, tracers));
     for (std::size_t i = 0; i < tracers; ++i) s.tracers.emplace_back(t[2 * i], t[2 * i + 1]);
+    const h5::Group::StoredNumber stored = g.stored_number("tracer_position");
+    s.output_spacing = std::max(s.output_spacing, binary_spacing(stored.floating, stored.bytes, t));
     s.fields.tracers = true;
   }
   s.time = g.has_attribute("time") ? checked_time(g.attribute_double("time"), requested_, k, where) : requested_[k];
@@ -177,10 +192,15 @@ namespace {
 struct CsvTable {
   std::vector<std::string> names;
   std::vector<std::vector<double>> columns;
+  std::vector<int> digits;  // the most significant digits of any number in each column
   std::optional<double> time;
   const std::vector<double>* find(const std::string& name) const {
     const auto it = std::find(names.begin(), names.end(), name);
     return it == names.end() ? nullptr : &columns[std::size_t(it - names.begin())];
+  }
+  double spacing(const std::string& name) const {
+    const auto it = std::find(names.begin(), names.end(), name);
+    return it == names.end() ? kDoubleSpacing : digits_spacing(digits[std::size_t(it - names.begin())]);
   }
 };
 
@@ -216,6 +236,7 @@ CsvTable read_csv_table(const std::string& path) {
     if (t.names.empty()) {
       t.names = cells;
       t.columns.assign(cells.size(), {});
+      t.digits.assign(cells.size(), 0);
       continue;
     }
     if (cells.size() != t.names.size())
@@ -228,6 +249,7 @@ CsvTable read_csv_table(const std::string& path) {
         throw ParticleOutputError(fmt::format("{}:{}: column '{}': '{}' is not a number", path, number, t.names[c],
                                               cells[c]));
       t.columns[c].push_back(v);
+      t.digits[c] = std::max(t.digits[c], significant_digits(cells[c]));
     }
   }
   if (t.names.empty()) throw ParticleOutputError(fmt::format("{}: no header line", path));
@@ -269,6 +291,8 @@ std::optional<OutputState> ParticleOutput::read_csv(std::size_t k, std::size_t t
     ArraySource::Rows a;
     a.rows = given[0]->size();
     a.values.resize(a.rows * width);
+    a.spacing = 0.0;
+    for (const char* c : columns.at(array)) a.spacing = std::max(a.spacing, t.spacing(c));
     for (std::size_t p = 0; p < a.rows; ++p)
       for (std::size_t c = 0; c < width; ++c) a.values[p * width + c] = (*given[c])[p];
     return a;
@@ -283,6 +307,7 @@ std::optional<OutputState> ParticleOutput::read_csv(std::size_t k, std::size_t t
     if (!tx || !ty) throw ParticleOutputError(fmt::format("{}: needs the columns x and y", tracer_path));
     check_tracers(tx->size(), tracers, tracer_path);
     for (std::size_t i = 0; i < tracers; ++i) s.tracers.emplace_back((*tx)[i], (*ty)[i]);
+    s.output_spacing = std::max({s.output_spacing, r.spacing("x"), r.spacing("y")});
     s.fields.tracers = true;
   }
   s.time = t.time ? checked_time(*t.time, requested_, k, path) : requested_[k];
@@ -325,6 +350,72 @@ std::optional<double> vtk_time(const VtkPoints& v, const std::string& path) {
   return std::nullopt;
 }
 
+// The components a plane-strain reading drops must vanish, or a 3-D code's
+// motion out of the plane would be measured as if it were plane strain: z -
+// Z of the points, a velocity's z, F's out-of-plane shears (and F_33 - 1), a
+// stress's out-of-plane shears, each against the largest magnitude of the
+// numbers it is a difference of (the in-plane components; |Z| for z - Z; 1 at
+// least for F), to 1e-9 of it or to 8 spacings of the numbers as written
+// (number_spacing.hpp) where those are coarser: a float code's round-off.
+constexpr double kPlaneTolerance = 1e-9;
+constexpr double kPlaneSpacings = 8.0;
+
+void check_plane(const VtkPoints& v, const std::string& path) {
+  struct Component {
+    std::size_t index;
+    double target;  // its plane-strain value
+    const char* name;
+  };
+  // `a`'s components `off` against their targets (or, with `base`, against
+  // base's same component), scaled by the largest of its components `in`.
+  auto check = [&](const char* what, const VtkArray& a, std::vector<std::size_t> in, std::vector<Component> off,
+                   const VtkArray* base) {
+    const std::size_t c = a.components, n = a.tuples();
+    double scale = 0.0, worst = 0.0;
+    std::size_t at = 0;
+    const Component* which = &off[0];
+    for (std::size_t p = 0; p < n; ++p) {
+      for (std::size_t i : in) {
+        scale = std::max(scale, std::abs(a.values[p * c + i]));
+        if (base) scale = std::max(scale, std::abs(base->values[p * c + i]));
+      }
+      for (const Component& k : off) {
+        if (base) scale = std::max(scale, std::abs(base->values[p * c + k.index]));  // a slab's |Z|
+        const double d = std::abs(a.values[p * c + k.index] - (base ? base->values[p * c + k.index] : k.target));
+        if (d > worst || std::isnan(d)) {
+          worst = d;
+          at = p;
+          which = &k;
+        }
+        if (std::isnan(d)) break;
+      }
+    }
+    if (std::string_view(what) == "deformation_gradient") scale = std::max(scale, 1.0);
+    const double tolerance =
+        std::max(kPlaneTolerance, kPlaneSpacings * std::max(a.spacing, base ? base->spacing : 0.0));
+    if (!(worst <= tolerance * scale))
+      throw ParticleOutputError(fmt::format(
+          "{}: {} is not plane strain: {} is {:.6g} at particle {} ({:.3g} of the largest in-plane magnitude, {:.6g}); "
+          "mpmvv reads the plane and drops the third components only where they vanish (to {:.3g} of it)",
+          path, what, which->name, worst, at, scale > 0.0 ? worst / scale : worst, scale, tolerance));
+  };
+  const auto array = [&](const char* name, std::size_t components) -> const VtkArray* {
+    const auto it = v.point_data.find(name);
+    return it != v.point_data.end() && it->second.components == components ? &it->second : nullptr;
+  };
+  if (const VtkArray* X = array("reference_position", 3); X && X->tuples() == v.points.tuples())
+    check("the points", v.points, {0, 1}, {{2, 0.0, "z - Z"}}, X);
+  if (const VtkArray* u = array("velocity", 3)) check("velocity", *u, {0, 1}, {{2, 0.0, "v_z"}}, nullptr);
+  if (const VtkArray* F = array("deformation_gradient", 9))
+    check("deformation_gradient", *F, {0, 1, 3, 4},
+          {{2, 0.0, "F_13"}, {5, 0.0, "F_23"}, {6, 0.0, "F_31"}, {7, 0.0, "F_32"}, {8, 1.0, "F_33 - 1"}}, nullptr);
+  if (const VtkArray* S = array("stress", 9))
+    check("stress", *S, {0, 1, 3, 4, 8}, {{2, 0.0, "sigma_xz"}, {5, 0.0, "sigma_yz"}, {6, 0.0, "sigma_zx"}, {7, 0.0, "sigma_zy"}},
+          nullptr);
+  if (const VtkArray* S = array("stress", 6))
+    check("stress", *S, {0, 1, 2, 3}, {{4, 0.0, "sigma_yz"}, {5, 0.0, "sigma_xz"}}, nullptr);
+}
+
 }  // namespace
 
 std::optional<OutputState> ParticleOutput::read_vtk(std::size_t k, std::size_t tracers) const {
@@ -361,6 +452,7 @@ std::optional<OutputState> ParticleOutput::read_vtk(std::size_t k, std::size_t t
     }
     ArraySource::Rows r;
     r.rows = n;
+    r.spacing = a->spacing;
     r.values.resize(n * width);
     for (std::size_t p = 0; p < n; ++p)
       for (std::size_t i = 0; i < width; ++i) r.values[p * width + i] = a->values[p * c + pick[i]];
@@ -368,10 +460,12 @@ std::optional<OutputState> ParticleOutput::read_vtk(std::size_t k, std::size_t t
   };
   OutputState s;
   fill_state(s, source, *path);
+  check_plane(v, *path);
   if (const auto tracer_path = vtk_file_of(path_, fmt::format("tracers_{}", k))) {
     const VtkPoints t = vtk_points(*tracer_path);
     check_tracers(t.points.tuples(), tracers, *tracer_path);
     for (std::size_t i = 0; i < tracers; ++i) s.tracers.emplace_back(t.points.values[3 * i], t.points.values[3 * i + 1]);
+    s.output_spacing = std::max(s.output_spacing, t.points.spacing);
     s.fields.tracers = true;
   }
   const std::optional<double> own = vtk_time(v, *path);

@@ -36,6 +36,10 @@ struct OutputState {
   std::vector<double> J;        // det F, from `J`, or volume / reference_volume (empty when neither)
   std::vector<Vec2> tracers;    // the tracers' current positions, in the input's order (empty when not given)
   OutputFields fields;
+  // The coarsest relative spacing of the numbers the norms are differences
+  // of, as written (number_spacing.hpp): positions, F, J, stress, velocity;
+  // 2.2e-16 for doubles, 1.2e-7 for floats, 10^(1-d) for text of d digits.
+  double output_spacing = 0.0;
 };
 
 class ParticleOutput {

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <string_view>
 
 #include <fmt/format.h>
 #include <pugixml.hpp>
@@ -61,9 +62,18 @@ std::vector<double> values_of(const std::string& bytes, ValueType t, bool big_en
   return v;
 }
 
-// Whitespace-separated numbers.
-std::vector<double> ascii_values(const char* text, const std::string& where) {
-  std::vector<double> v;
+// An array's values from binary numbers of type t, their spacing with them.
+VtkArray binary_array(const std::string& bytes, ValueType t, bool big_endian) {
+  VtkArray a;
+  a.values = values_of(bytes, t, big_endian);
+  a.spacing = binary_spacing(t.kind == ValueType::floating, t.size, a.values);
+  return a;
+}
+
+// Whitespace-separated numbers; their spacing from the most digits any has.
+VtkArray ascii_values(const char* text, const std::string& where) {
+  VtkArray a;
+  int digits = 0;
   const char* p = text;
   for (;;) {
     while (*p && std::isspace(static_cast<unsigned char>(*p))) ++p;
@@ -71,10 +81,12 @@ std::vector<double> ascii_values(const char* text, const std::string& where) {
     char* end = nullptr;
     const double x = std::strtod(p, &end);
     if (end == p) throw VtkFileError(fmt::format("{}: '{}' is not a number", where, std::string(p, std::min<std::size_t>(std::strlen(p), 20))));
-    v.push_back(x);
+    a.values.push_back(x);
+    digits = std::max(digits, significant_digits(std::string_view(p, std::size_t(end - p))));
     p = end;
   }
-  return v;
+  a.spacing = digits_spacing(digits);
+  return a;
 }
 
 // ---------------------------------------------------------------- XML files
@@ -178,31 +190,33 @@ std::string binary_bytes(ByteStream& in, const XmlLayout& L, const std::string& 
 VtkArray xml_array(const pugi::xml_node& a, const XmlLayout& L, const std::string& file) {
   const std::string name = a.attribute("Name").as_string();
   const std::string where = fmt::format("{}: DataArray '{}'", file, name);
-  VtkArray out;
-  out.components = a.attribute("NumberOfComponents").as_ullong(1);
-  if (out.components == 0) throw VtkFileError(fmt::format("{}: NumberOfComponents is 0", where));
+  const std::size_t components = a.attribute("NumberOfComponents").as_ullong(1);
+  if (components == 0) throw VtkFileError(fmt::format("{}: NumberOfComponents is 0", where));
   const ValueType type = xml_type(a.attribute("type").as_string(), where);
   const std::string format = a.attribute("format").as_string("ascii");
+  VtkArray out;
   if (format == "ascii") {
-    out.values = ascii_values(a.child_value(), where);
+    out = ascii_values(a.child_value(), where);
   } else if (format == "binary") {
     const std::string text = a.child_value();
     ByteStream in(text, 0, true, where);
-    out.values = values_of(binary_bytes(in, L, where), type, L.big_endian);
+    out = binary_array(binary_bytes(in, L, where), type, L.big_endian);
   } else if (format == "appended") {
     if (!L.appended) throw VtkFileError(fmt::format("{}: format appended, but the file has no AppendedData", where));
     if (a.attribute("offset").empty()) throw VtkFileError(fmt::format("{}: format appended needs an offset", where));
     ByteStream in(*L.appended, a.attribute("offset").as_ullong(), L.appended_base64, where);
-    out.values = values_of(binary_bytes(in, L, where), type, L.big_endian);
+    out = binary_array(binary_bytes(in, L, where), type, L.big_endian);
   } else {
     throw VtkFileError(fmt::format("{}: format '{}' is none of ascii, binary, appended", where, format));
   }
+  out.components = components;
   if (out.values.size() % out.components != 0)
     throw VtkFileError(fmt::format("{}: {} values are not whole tuples of {}", where, out.values.size(), out.components));
   return out;
 }
 
 void append(VtkArray& into, const VtkArray& a) {
+  into.spacing = into.values.empty() ? a.spacing : std::max(into.spacing, a.spacing);
   into.components = a.components;
   into.values.insert(into.values.end(), a.values.begin(), a.values.end());
 }
@@ -304,7 +318,7 @@ class LegacyReader {
           throw VtkFileError(fmt::format("{}: DATASET {}: particles are read from POLYDATA or UNSTRUCTURED_GRID", path_, type));
       } else if (key == "POINTS") {
         const std::size_t n = count("POINTS");
-        out.points = {3, values(3 * n, type_of(token()))};
+        out.points = values(3 * n, type_of(token()), 3);
       } else if (key == "VERTICES" || key == "LINES" || key == "POLYGONS" || key == "TRIANGLE_STRIPS" || key == "CELLS") {
         const std::size_t n = count(key), size = count(key);
         skip_connectivity(n, size);
@@ -327,11 +341,11 @@ class LegacyReader {
         }
         if (upper(next) != "LOOKUP_TABLE") throw VtkFileError(fmt::format("{}: SCALARS {}: no LOOKUP_TABLE line", path_, name));
         token();  // the table's name
-        (*data)[name] = {components, values(expected * components, t)};
+        (*data)[name] = values(expected * components, t, components);
       } else if (key == "VECTORS" || key == "NORMALS" || key == "TENSORS" || key == "TENSORS6") {
         const std::string name = token();
         const std::size_t components = key == "TENSORS" ? 9 : key == "TENSORS6" ? 6 : 3;
-        (*data)[name] = {components, values(expected * components, type_of(token()))};
+        (*data)[name] = values(expected * components, type_of(token()), components);
       } else if (key == "FIELD") {
         token();  // its name
         const std::size_t arrays = count("FIELD");
@@ -341,7 +355,7 @@ class LegacyReader {
           const ValueType t = type_of(token());
           if (data == &out.point_data && tuples != expected)
             throw VtkFileError(fmt::format("{}: FIELD array '{}' has {} tuples for {} points", path_, name, tuples, expected));
-          (*data)[name] = {components, values(components * tuples, t)};
+          (*data)[name] = values(components * tuples, t, components);
         }
       } else if (key == "METADATA") {
         while (pos_ < text_.size() && !trim(line()).empty()) {}
@@ -398,25 +412,31 @@ class LegacyReader {
     if (it == types.end()) throw VtkFileError(fmt::format("{}: data type '{}' is not read", path_, name));
     return it->second;
   }
-  // n values of type t: text numbers, or big-endian bytes from the line after the header.
-  std::vector<double> values(std::size_t n, ValueType t) {
+  // n values of type t: text numbers, or big-endian bytes from the line
+  // after the header; as `components`-tuples, with their spacing.
+  VtkArray values(std::size_t n, ValueType t, std::size_t components = 1) {
+    VtkArray a;
     if (!binary_) {
-      std::vector<double> v(n);
+      a.values.resize(n);
+      int digits = 0;
       for (std::size_t i = 0; i < n; ++i) {
         const std::string s = token();
         char* end = nullptr;
-        v[i] = std::strtod(s.c_str(), &end);
+        a.values[i] = std::strtod(s.c_str(), &end);
         if (s.empty() || *end != '\0')
           throw VtkFileError(fmt::format("{}: value {} of {}: '{}' is not a number", path_, i, n, s));
+        digits = std::max(digits, significant_digits(s));
       }
-      return v;
+      a.spacing = digits_spacing(digits);
+    } else {
+      line();  // the rest of the header line
+      if (pos_ + n * t.size > text_.size())
+        throw VtkFileError(fmt::format("{}: the binary data end before {} values", path_, n));
+      a = binary_array(text_.substr(pos_, n * t.size), t, true);
+      pos_ += n * t.size;
     }
-    line();  // the rest of the header line
-    if (pos_ + n * t.size > text_.size())
-      throw VtkFileError(fmt::format("{}: the binary data end before {} values", path_, n));
-    const std::string bytes = text_.substr(pos_, n * t.size);
-    pos_ += n * t.size;
-    return values_of(bytes, t, true);
+    a.components = components;
+    return a;
   }
   // Cells: the old layout (size integers) or version 5's OFFSETS and CONNECTIVITY.
   void skip_connectivity(std::size_t n, std::size_t size) {

@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "number_spacing.hpp"
+
 namespace mpmvv::app {
 
 // A file that cannot be read as VTK: the message names the file and the item.
@@ -23,6 +25,7 @@ struct VtkFileError : std::runtime_error {
 struct VtkArray {
   std::size_t components = 1;
   std::vector<double> values;
+  double spacing = kDoubleSpacing;  // relative, of the numbers as stored (number_spacing.hpp)
   std::size_t tuples() const { return components == 0 ? 0 : values.size() / components; }
 };
 
