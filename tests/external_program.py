@@ -8,7 +8,9 @@ reports/external-format.md):
   of the user-motion scene plus a known offset, at its own times near the
   output times (CSV): every displacement norm and the probe lines read the
   offset, the velocity norm the velocity's offset, and no stress or F norm is
-  made from fields it did not write;
+  made from fields it did not write; moved by a quadratic motion of its own
+  and writing no tracers, the probe lines mpmvv measures from tracers it
+  places from the particles equal those of the tracers written;
 - what goes wrong is named: a program that exits 3 (failed, its last line
   quoted, the outputs it wrote kept), one that writes no output, a malformed
   CSV (file and line), an unknown {name} (refused before anything runs), a
@@ -60,6 +62,9 @@ inp = json.load(open(sys.argv[1]))
 mode = sys.argv[2] if len(sys.argv) > 2 else "good"
 A, c, L = 0.05, 100.0, 1.0
 def u(X, Y, t):
+    if mode.startswith("quadratic"):  # the motion with sin(pi s) as 4 s (1 - s): a quadratic fit reproduces it
+        return (A * 4.0 * X * (1.0 - X) * math.sin(c * math.pi * t / L),
+                A * 4.0 * Y * (1.0 - Y) * math.sin(math.pi * (2.0 / 3.0 + c * t / L)))
     return (A * math.sin(math.pi * X / L) * math.sin(c * math.pi * t / L),
             A * math.sin(math.pi * Y / L) * math.sin(math.pi * (2.0 / 3.0 + c * t / L)))
 def v(X, Y, t):
@@ -85,6 +90,8 @@ for k, t_out in enumerate(inp["output_times"]):
                 vx, vy = v(X, Y, t)
                 f.write("%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n" % (
                     X, Y, X + ux + OX, Y + uy + OY, V0, vx + VOX, vy + VOY))
+    if mode.endswith("notracers"):
+        continue
     with open(os.path.join(inp["output"], "tracers_%d.csv" % k), "w") as f:
         f.write("x,y\n")
         for X, Y in inp["tracer_reference"]:
@@ -149,6 +156,29 @@ with tempfile.TemporaryDirectory() as tmp:
             check(f["external"].attrs["J_rule"].startswith("not applied"), "no F, J or volume: the J rule is not applied")
             check(np.allclose(f["external"]["output_time"][()] - e["time"][()], 1e-6), "the program's own times kept")
             check(f.attrs["particle_count"] == 37 * 23, f"particle_count {f.attrs['particle_count']}")
+
+    # A program that follows no tracers: mpmvv places them from its particles
+    # (tracer_interpolation.hpp), exactly for a quadratic motion, so the probe
+    # lines read what the program's own tracers give.
+    written = run(USER, *user, f"external_command=/usr/bin/python3 {program} {{input}} quadratic",
+                  output=tmp / "written.h5")
+    placed = run(USER, *user, f"external_command=/usr/bin/python3 {program} {{input}} quadratic-notracers",
+                 output=tmp / "placed.h5")
+    check(written.returncode == 0 and placed.returncode == 0,
+          f"tracers written and placed: exit {written.returncode}, {placed.returncode}: {placed.stdout}{placed.stderr}")
+    if written.returncode == 0 and placed.returncode == 0:
+        with h5py.File(tmp / "written.h5") as a, h5py.File(tmp / "placed.h5") as b:
+            lines = [n for n in a["errors"] if n.startswith("L1_")]
+            check(lines and list(a["errors"]) == list(b["errors"]) and a.attrs["health"] == "healthy",
+                  f"columns {list(a['errors'])} against {list(b['errors'])}")
+            for name in lines:
+                want, got = a["errors"][name][()], b["errors"][name][()]
+                check(np.all(want > 1e-5) and np.allclose(got, want, rtol=1e-10, atol=1e-15),
+                      f"/errors/{name}: placed {got}, written {want}")
+            check(a["external"].attrs["tracers"] == "written by the program (tracer_position)"
+                  and b["external"].attrs["tracers"].startswith("interpolated by mpmvv from the particles"),
+                  f"/external tracers: {a['external'].attrs['tracers']!r}, {b['external'].attrs['tracers']!r}")
+            check("tracer_position" not in b["external"].attrs["fields"], f"fields: {b['external'].attrs['fields']}")
 
     # Failures, each named, nothing computed lost.
     failed = run(USER, *user, f"external_command=/usr/bin/python3 {program} {{input}} fail", output=tmp / "fail.h5")

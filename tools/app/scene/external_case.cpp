@@ -19,6 +19,7 @@
 #include "setup.hpp"
 #include "solver/parallel.hpp"
 #include "tools/app/installation.hpp"
+#include "tracer_interpolation.hpp"
 
 namespace mpmvv::app {
 
@@ -109,6 +110,14 @@ class ExternalCase final : public SceneCase {
         return finish(o, k, "malformed output",
                       fmt::format("output {} holds {}; output 0 held {}", k, fields_text(state->fields),
                                   fields_text(fields_)));
+      if (interpolated_tracers_) {
+        try {
+          state->tracers = interpolated_tracers(state->P.reference_position, state->P.position,
+                                                state->P.reference_volume, probes_.tracer_references());
+        } catch (const TracerInterpolationError& e) {
+          return finish(o, k, "malformed output", fmt::format("output {}: {}", k, e.what()));
+        }
+      }
       record(k, *state);
       output_spacing_ = k == 0 ? state->output_spacing : std::max(output_spacing_, state->output_spacing);
       o.time_reached = loop_.output_times[k];
@@ -146,9 +155,10 @@ class ExternalCase final : public SceneCase {
   double body_volume() const override { return exact_body_volume(setup_); }
   const ErrorTable& errors() const override { return errors_; }
   std::string error_description() const override {
-    return fmt::format("{}; computed by mpmvv from the external program's particles (given: {}; "
+    return fmt::format("{}; computed by mpmvv from the external program's particles (given: {}{}; "
                        "reports/external-format.md)",
-                       norm_definitions(), fields_text(fields_));
+                       norm_definitions(), fields_text(fields_),
+                       interpolated_tracers_ ? "; the probe lines' tracers placed by mpmvv from the particles" : "");
   }
   std::optional<double> exact_signal_fraction(const std::string& norm, double time) const override {
     return app::exact_signal_fraction(setup_, loop_, norm, time);
@@ -182,6 +192,9 @@ class ExternalCase final : public SceneCase {
     g.set_attribute("wall_time_s", end_.seconds);
     g.set_attribute("log_tail", end_.log_tail);
     g.set_attribute("fields", fields_text(fields_));
+    g.set_attribute("tracers", fields_.tracers          ? "written by the program (tracer_position)"
+                               : interpolated_tracers_ ? tracer_interpolation_description()
+                                                       : "none: the scene has no probes");
     g.set_attribute("J_rule", j_given() ? "applied" : "not applied: the program gave no F, J or volume");
     // The report's round-off floor counts this rounding (reports/orders.py: OUTPUT_SPACING_UNITS).
     g.set_attribute("output_spacing", output_spacing_);
@@ -196,7 +209,9 @@ class ExternalCase final : public SceneCase {
   void start(const OutputState& first) {
     fields_ = first.fields;
     errors_ = ErrorTable{};
-    if (fields_.tracers)
+    // A program that follows no tracers gets them placed from its particles.
+    interpolated_tracers_ = !fields_.tracers && !probes_.tracer_references().empty();
+    if (fields_.tracers || interpolated_tracers_)
       for (const ProbeLine& line : setup_.lines) errors_.add_column("L1_" + line.name);
     for (std::size_t c = 0; c < std::size(kParticleNorms); ++c)
       if (norm_given(kParticleNorms[c], fields_)) errors_.add_column(kParticleNorms[c]);
@@ -217,7 +232,7 @@ class ExternalCase final : public SceneCase {
     errors_.time.push_back(loop_.output_times[k]);
     program_time_.push_back(s.time);
     std::size_t column = 0;
-    if (fields_.tracers)
+    if (fields_.tracers || interpolated_tracers_)
       for (double l1 : probes_.at_output(s.time, s.tracers)) errors_.columns[column++].second.push_back(l1);
     double spin = 0.0;
     const std::vector<double> norms =
@@ -258,6 +273,7 @@ class ExternalCase final : public SceneCase {
   TimeIntegral integrated_;
   std::vector<double> j_ratio_, program_time_;
   double output_spacing_ = 0.0;  // the coarsest of the outputs' (OutputState::output_spacing)
+  bool interpolated_tracers_ = false;  // the program wrote none: tracer_interpolation.hpp places them
   std::vector<HealthSample> samples_;
   double motion_ = 0.0;
 };
