@@ -20,7 +20,9 @@ component shows), and writes them:
 Every binary layout gives /errors and /particles equal to the CSV's bit for
 bit; the 12-digit ascii one within 1e-9, its output_spacing 1e-11 (the
 doubles' 2.2e-16). A missing required array, particles moved out of the
-plane and two files for one output time are named.
+plane and two files for one output time are named. Arrays named as the
+program names them, mapped by external_names, read as the CSV; a name the
+layout lacks, or one file name for two items, is refused.
 
     /usr/bin/python3 tests/external_vtk.py MPMVV   (ctest runs it; exit 1 names what failed)
 """
@@ -181,6 +183,9 @@ for k, t_out in enumerate(inp["output_times"]):
         S6 = np.c_[S[:, 0, 0], S[:, 1, 1], np.zeros(N), S[:, 0, 1], np.zeros(N), np.zeros(N)]
         arrays = [("reference_position", xyz(np.c_[X, Y])), ("reference_volume", V0), ("velocity", vel),
                   ("stress", S6), ("deformation_gradient", full(F, 1.0)), ("volume", V)]
+        if "renamed" in sys.argv[3:]:  # a code's own names (external_names maps them)
+            own = {"reference_volume": "vol0", "velocity": "velocities", "stress": "stresses"}
+            arrays = [(own.get(n, n), a) for n, a in arrays]
         points = xyz(x)
         if "bent" in sys.argv[3:]:  # a 3-D code's motion out of the plane
             points[:, 2] = 1e-3 * X * t
@@ -202,11 +207,12 @@ for k, t_out in enumerate(inp["output_times"]):
 SETS = ["cells=16", "end_time=0.02"]
 
 
-def run(tmp, name, fmt, *args):
+def run(tmp, name, fmt, *args, names=""):
     output = tmp / f"{name}.h5"
     command = f"/usr/bin/python3 {tmp / 'toy.py'} {{input}} {' '.join(args)}"
     r = subprocess.run([MPMVV, "run", str(USER), "--threads", "1", "--quiet", "-o", str(output), "--set", SETS[0],
-                        "--set", SETS[1], "--set", f"external_format={fmt}", "--set", f"external_command={command}"],
+                        "--set", SETS[1], "--set", f"external_format={fmt}", "--set", f"external_command={command}",
+                        "--set", f"external_names={names}"],
                        capture_output=True, text=True, timeout=120)
     return r, output
 
@@ -271,6 +277,27 @@ with tempfile.TemporaryDirectory() as tmp:
     if path.exists():
         with h5py.File(path) as f:
             check(len(f["errors"]["time"]) == 1, "the output read before the malformed one is kept")
+    # A code's own array names, mapped by external_names: the same results.
+    r, path = run(tmp, "renamed", "vtk", "vtp", "renamed",
+                  names="reference_volume=vol0, velocity=velocities,stress = stresses")
+    check(r.returncode == 0, f"renamed arrays: exit {r.returncode}: {r.stdout}{r.stderr}")
+    if r.returncode == 0:
+        got, want = datasets(path), references[""]
+        check(sorted(got) == sorted(want) and all(np.array_equal(got[n], want[n], equal_nan=True)
+                                                  if isinstance(want[n], np.ndarray) else got[n] == want[n]
+                                                  for n in want),
+              "renamed arrays: the results differ from the CSV's")
+        with h5py.File(path) as f:
+            check(f["external"].attrs["names"].startswith("reference_volume=vol0"), "/external names")
+    r, _ = run(tmp, "unmapped", "vtk", "vtp", "renamed")
+    check(r.returncode == 1 and "no point array 'vol0'" not in r.stdout and "no point array 'reference_volume'" in r.stdout,
+          f"renamed arrays without the map: {r.stdout}")
+    r, _ = run(tmp, "nonsense", "vtk", "vtp", names="volume0=vol0")
+    check(r.returncode == 2 and "external_names" in r.stderr and "'volume0' is not an item of the vtk layout" in r.stderr,
+          f"a name the layout does not have: {r.returncode}: {r.stderr}")
+    r, _ = run(tmp, "twice-named", "vtk", "vtp", names="volume=v, mass=v")
+    check(r.returncode == 2 and "'v' is the file's name of both volume and mass" in r.stderr,
+          f"one file name for two items: {r.stderr}")
     r, _ = run(tmp, "bent", "vtk", "vtp", "bent")
     check(r.returncode == 1 and "malformed output" in r.stdout and "the points is not plane strain: z - Z" in r.stdout,
           f"particles moved out of the plane: {r.stdout}")

@@ -289,4 +289,28 @@ TEST(VtkFile, OnlyThePlaneIsRead) {
   EXPECT_TRUE(refused(read_message("particles_0.vtp", floats(5e-4f)), "v_z is 0.0005"));
 }
 
+TEST(OutputNames, EachLayoutMapsItsOwnItems) {
+  using mpmvv::app::parse_output_names;
+  const auto csv = parse_output_names(" V0 = vol , vx=u,vy=v,", "csv");
+  EXPECT_EQ(csv.at("V0"), "vol");
+  EXPECT_EQ(csv.at("vy"), "v");
+  EXPECT_EQ(csv.size(), 3u);
+  EXPECT_TRUE(parse_output_names("", "hdf5").empty());
+  EXPECT_EQ(parse_output_names("tracer_position=tracers", "hdf5").at("tracer_position"), "tracers");
+  const auto message = [](const std::string& text, const std::string& format) {
+    try {
+      parse_output_names(text, format);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("(parsed)");
+  };
+  // A CSV has columns, VTK has no named positions.
+  EXPECT_NE(message("reference_volume=vol", "csv").find("not an item of the csv layout, whose names are X, Y"),
+            std::string::npos);
+  EXPECT_NE(message("position=pos", "vtk").find("(the positions are the points)"), std::string::npos);
+  EXPECT_NE(message("mass=", "vtk").find("'mass' is given no file name"), std::string::npos);
+  EXPECT_NE(message("mass=m, mass=n", "vtk").find("'mass' is named twice"), std::string::npos);
+}
+
 }  // namespace

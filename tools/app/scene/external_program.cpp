@@ -39,6 +39,11 @@ std::vector<KeySpec> external_program_keys() {
        "what the external program writes at {output}: hdf5 (one file, a group per output time), csv or vtk (a "
        "folder, a file per output time: .csv; .vtu, .vtp or legacy .vtk); reports/external-format.md",
        -inf, inf, false, false, {"hdf5", "csv", "vtk"}},
+      {"external_names", KeyKind::text, std::string(""),
+       "how the external program's files name mpmvv's items, where they differ: NAME=FILE_NAME pairs separated "
+       "by commas, NAME a dataset or point array of the hdf5 and vtk layouts or a column of the csv one "
+       "(e.g. \"reference_volume=vol0, velocity=velocities\"; reports/external-format.md)",
+       -inf, inf},
       {"external_timeout", KeyKind::real, 0.0,
        "seconds after which the external program is ended and the case fails (0: no limit of its own; a suite's "
        "time-out still applies)",
@@ -48,8 +53,14 @@ std::vector<KeySpec> external_program_keys() {
 
 std::optional<ExternalProgram> external_program(const Config& config) {
   if (!config.has("external_command") || config.text("external_command").empty()) return std::nullopt;
+  OutputNames names;
+  try {
+    names = parse_output_names(config.text("external_names"), config.text("external_format"));
+  } catch (const std::invalid_argument& e) {
+    config.reject("external_names", e.what());
+  }
   return ExternalProgram{config.text("external_command"), config.text("external_format"),
-                         config.real("external_timeout")};
+                         config.real("external_timeout"), std::move(names)};
 }
 
 ExternalFiles external_files(const std::string& results_path, const std::string& format) {

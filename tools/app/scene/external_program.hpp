@@ -12,6 +12,7 @@
 
 #include "solver/tensor.hpp"
 #include "tools/app/config.hpp"
+#include "tools/app/scene/particle_output.hpp"
 
 namespace mpmvv::app {
 
@@ -22,8 +23,10 @@ struct ExternalProgram {
   std::string command;  // the template, as configured
   std::string format;   // "hdf5", "csv" or "vtk": what the program writes at {output}
   double timeout = 0.0;  // seconds; 0: none of its own
+  OutputNames names;    // external_names: how its files spell mpmvv's items
 };
-// The program `config` names, or none (external_command = "": mpmvv's own solver).
+// The program `config` names, or none (external_command = "": mpmvv's own
+// solver). A malformed external_names is refused (ConfigError naming it).
 std::optional<ExternalProgram> external_program(const Config& config);
 
 // Where a case's files go (absolute paths), beside its results file RESULTS.h5: RESULTS.input.json

@@ -136,8 +136,63 @@ void check_tracers(std::size_t given, std::size_t tracers, const std::string& wh
 
 }  // namespace
 
-ParticleOutput::ParticleOutput(std::string path, std::string format, std::vector<double> requested)
-    : path_(std::move(path)), format_(std::move(format)), requested_(std::move(requested)) {}
+namespace {
+
+// The items each format's files hold under mpmvv's names (external-format.md);
+// VTK's positions are its points, which carry no name.
+const std::vector<std::string>& own_names(const std::string& format) {
+  static const std::vector<std::string> arrays = {"reference_position", "position", "reference_volume", "velocity",
+                                                  "stress", "deformation_gradient", "J", "volume", "mass",
+                                                  "tracer_position"};
+  static const std::vector<std::string> point_arrays = {"reference_position", "reference_volume", "velocity", "stress",
+                                                        "deformation_gradient", "J", "volume", "mass"};
+  static const std::vector<std::string> columns = {"X",   "Y",   "x",   "y",   "V0",  "vx", "vy", "sxx", "syy",
+                                                   "sxy", "F11", "F12", "F21", "F22", "J",  "V",  "m"};
+  return format == "csv" ? columns : format == "vtk" ? point_arrays : arrays;
+}
+
+std::string trimmed_text(const std::string& s) {
+  const auto first = s.find_first_not_of(" \t");
+  return first == std::string::npos ? std::string() : s.substr(first, s.find_last_not_of(" \t") - first + 1);
+}
+
+}  // namespace
+
+OutputNames parse_output_names(const std::string& text, const std::string& format) {
+  OutputNames names;
+  const std::vector<std::string>& own = own_names(format);
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', start), text.size());
+    const std::string pair = trimmed_text(text.substr(start, comma - start));
+    start = comma + 1;
+    if (pair.empty()) continue;
+    const std::size_t eq = pair.find('=');
+    if (eq == std::string::npos)
+      throw std::invalid_argument(fmt::format("'{}' is no NAME=FILE_NAME pair (e.g. reference_volume=vol0)", pair));
+    const std::string name = trimmed_text(pair.substr(0, eq)), file = trimmed_text(pair.substr(eq + 1));
+    if (std::find(own.begin(), own.end(), name) == own.end()) {
+      std::string list;
+      for (const std::string& n : own) list += (list.empty() ? "" : ", ") + n;
+      throw std::invalid_argument(fmt::format("'{}' is not an item of the {} layout, whose names are {}{}", name, format,
+                                              list, format == "vtk" ? " (the positions are the points)" : ""));
+    }
+    if (file.empty()) throw std::invalid_argument(fmt::format("'{}' is given no file name", name));
+    if (names.count(name)) throw std::invalid_argument(fmt::format("'{}' is named twice", name));
+    for (const auto& [other, given] : names)
+      if (given == file) throw std::invalid_argument(fmt::format("'{}' is the file's name of both {} and {}", file, other, name));
+    names[name] = file;
+  }
+  return names;
+}
+
+ParticleOutput::ParticleOutput(std::string path, std::string format, std::vector<double> requested, OutputNames names)
+    : path_(std::move(path)), format_(std::move(format)), requested_(std::move(requested)), names_(std::move(names)) {}
+
+std::string ParticleOutput::named(const std::string& own) const {
+  const auto it = names_.find(own);
+  return it == names_.end() ? own : it->second;
+}
 
 std::optional<OutputState> ParticleOutput::read(std::size_t k, std::size_t tracers) const {
   if (format_ == "csv") return read_csv(k, tracers);
@@ -157,7 +212,8 @@ std::optional<OutputState> ParticleOutput::read_hdf5(std::size_t k, std::size_t 
   const std::string where = fmt::format("{}:/snapshots/{}", path_, name);
   // A dataset of N rows (N x 2 x 2 counts as N x 4).
   ArraySource source;
-  source.get = [&](const std::string& dataset, std::size_t) -> std::optional<ArraySource::Rows> {
+  source.get = [&](const std::string& item, std::size_t) -> std::optional<ArraySource::Rows> {
+    const std::string& dataset = named(item);
     if (!g.has(dataset)) return std::nullopt;
     std::vector<hsize_t> d;
     ArraySource::Rows a;
@@ -167,16 +223,16 @@ std::optional<OutputState> ParticleOutput::read_hdf5(std::size_t k, std::size_t 
     a.spacing = binary_spacing(stored.floating, stored.bytes, a.values);
     return a;
   };
-  source.spelled = [](const std::string& dataset) { return fmt::format("dataset '{}'", dataset); };
+  source.spelled = [&](const std::string& item) { return fmt::format("dataset '{}'", named(item)); };
   OutputState s;
   fill_state(s, source, where);
-  if (g.has("tracer_position")) {
+  if (const std::string& tracer = named("tracer_position"); g.has(tracer)) {
     std::vector<hsize_t> d;
-    const std::vector<double> t = g.read_doubles("tracer_position", &d);
+    const std::vector<double> t = g.read_doubles(tracer, &d);
     if (d.size() != 2 || d[0] != tracers || d[1] != 2)
-      throw ParticleOutputError(fmt::format("{}/tracer_position: must be {} x 2 (the input file's tracers)", where, tracers));
+      throw ParticleOutputError(fmt::format("{}/{}: must be {} x 2 (the input file's tracers)", where, tracer, tracers));
     for (std::size_t i = 0; i < tracers; ++i) s.tracers.emplace_back(t[2 * i], t[2 * i + 1]);
-    const h5::Group::StoredNumber stored = g.stored_number("tracer_position");
+    const h5::Group::StoredNumber stored = g.stored_number(tracer);
     s.output_spacing = std::max(s.output_spacing, binary_spacing(stored.floating, stored.bytes, t));
     s.fields.tracers = true;
   }
@@ -268,10 +324,10 @@ std::optional<OutputState> ParticleOutput::read_csv(std::size_t k, std::size_t t
       {"reference_position", {"X", "Y"}}, {"position", {"x", "y"}}, {"reference_volume", {"V0"}},
       {"velocity", {"vx", "vy"}}, {"stress", {"sxx", "sxy", "sxy", "syy"}},
       {"deformation_gradient", {"F11", "F12", "F21", "F22"}}, {"volume", {"V"}}, {"mass", {"m"}}, {"J", {"J"}}};
-  auto names = [](const std::string& array) {
+  auto names = [&](const std::string& array) {
     std::vector<std::string> unique;
     for (const char* c : columns.at(array))
-      if (std::find(unique.begin(), unique.end(), c) == unique.end()) unique.push_back(c);
+      if (std::find(unique.begin(), unique.end(), named(c)) == unique.end()) unique.push_back(named(c));
     return unique;
   };
   ArraySource source;
@@ -283,7 +339,7 @@ std::optional<OutputState> ParticleOutput::read_csv(std::size_t k, std::size_t t
   };
   source.get = [&](const std::string& array, std::size_t width) -> std::optional<ArraySource::Rows> {
     std::vector<const std::vector<double>*> given;
-    for (const char* c : columns.at(array)) given.push_back(t.find(c));
+    for (const char* c : columns.at(array)) given.push_back(t.find(named(c)));
     const auto present = std::count_if(given.begin(), given.end(), [](auto* c) { return c != nullptr; });
     if (present == 0) return std::nullopt;
     if (present != std::ptrdiff_t(given.size()))
@@ -292,7 +348,7 @@ std::optional<OutputState> ParticleOutput::read_csv(std::size_t k, std::size_t t
     a.rows = given[0]->size();
     a.values.resize(a.rows * width);
     a.spacing = 0.0;
-    for (const char* c : columns.at(array)) a.spacing = std::max(a.spacing, t.spacing(c));
+    for (const char* c : columns.at(array)) a.spacing = std::max(a.spacing, t.spacing(named(c)));
     for (std::size_t p = 0; p < a.rows; ++p)
       for (std::size_t c = 0; c < width; ++c) a.values[p * width + c] = (*given[c])[p];
     return a;
@@ -360,7 +416,8 @@ std::optional<double> vtk_time(const VtkPoints& v, const std::string& path) {
 constexpr double kPlaneTolerance = 1e-9;
 constexpr double kPlaneSpacings = 8.0;
 
-void check_plane(const VtkPoints& v, const std::string& path) {
+void check_plane(const VtkPoints& v, const std::string& path,
+                 const std::function<std::string(const char*)>& named) {
   struct Component {
     std::size_t index;
     double target;  // its plane-strain value
@@ -400,7 +457,7 @@ void check_plane(const VtkPoints& v, const std::string& path) {
           path, what, which->name, worst, at, scale > 0.0 ? worst / scale : worst, scale, tolerance));
   };
   const auto array = [&](const char* name, std::size_t components) -> const VtkArray* {
-    const auto it = v.point_data.find(name);
+    const auto it = v.point_data.find(named(name));
     return it != v.point_data.end() && it->second.components == components ? &it->second : nullptr;
   };
   if (const VtkArray* X = array("reference_position", 3); X && X->tuples() == v.points.tuples())
@@ -423,8 +480,8 @@ std::optional<OutputState> ParticleOutput::read_vtk(std::size_t k, std::size_t t
   if (!path) return std::nullopt;
   const VtkPoints v = vtk_points(*path);
   ArraySource source;
-  source.spelled = [](const std::string& array) {
-    return array == "position" ? std::string("points") : fmt::format("point array '{}'", array);
+  source.spelled = [&](const std::string& array) {
+    return array == "position" ? std::string("points") : fmt::format("point array '{}'", named(array));
   };
   // VTK's tuples hold 3 components where mpmvv's plane holds 2: a vector's
   // z and a tensor's third row and column are dropped; a symmetric tensor of
@@ -432,7 +489,7 @@ std::optional<OutputState> ParticleOutput::read_vtk(std::size_t k, std::size_t t
   source.get = [&](const std::string& array, std::size_t width) -> std::optional<ArraySource::Rows> {
     const VtkArray* a = &v.points;
     if (array != "position") {
-      const auto it = v.point_data.find(array);
+      const auto it = v.point_data.find(named(array));
       if (it == v.point_data.end()) return std::nullopt;
       a = &it->second;
     }
@@ -460,7 +517,7 @@ std::optional<OutputState> ParticleOutput::read_vtk(std::size_t k, std::size_t t
   };
   OutputState s;
   fill_state(s, source, *path);
-  check_plane(v, *path);
+  check_plane(v, *path, [&](const char* array) { return named(array); });
   if (const auto tracer_path = vtk_file_of(path_, fmt::format("tracers_{}", k))) {
     const VtkPoints t = vtk_points(*tracer_path);
     check_tracers(t.points.tuples(), tracers, *tracer_path);

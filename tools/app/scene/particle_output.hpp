@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstddef>
+#include <map>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -42,10 +43,22 @@ struct OutputState {
   double output_spacing = 0.0;
 };
 
+// How a program's files spell mpmvv's items (external_names): mpmvv's name
+// (a dataset or point array of the HDF5 and VTK layouts, a column of the CSV
+// one) to the file's.
+using OutputNames = std::map<std::string, std::string>;
+
+// "reference_volume=vol0, velocity=velocities" for `format` (hdf5, csv,
+// vtk); throws std::invalid_argument saying what is wrong (a pair without
+// '=', a name the format does not have, listing those it has, a name or a
+// file's name given twice).
+OutputNames parse_output_names(const std::string& text, const std::string& format);
+
 class ParticleOutput {
  public:
-  // `path` and `format` as the input file named them; `requested` the output times.
-  ParticleOutput(std::string path, std::string format, std::vector<double> requested);
+  // `path` and `format` as the input file named them; `requested` the output
+  // times; `names` how the files spell the items they are not named as.
+  ParticleOutput(std::string path, std::string format, std::vector<double> requested, OutputNames names = {});
   // The output for requested time k, or none when the program wrote none
   // for it; throws ParticleOutputError when what it wrote is malformed
   // (a missing required item, a row count or a column that does not match,
@@ -56,8 +69,11 @@ class ParticleOutput {
   std::optional<OutputState> read_hdf5(std::size_t k, std::size_t tracers) const;
   std::optional<OutputState> read_csv(std::size_t k, std::size_t tracers) const;
   std::optional<OutputState> read_vtk(std::size_t k, std::size_t tracers) const;
+  // The file's name of mpmvv's item `own`.
+  std::string named(const std::string& own) const;
   std::string path_, format_;
   std::vector<double> requested_;
+  OutputNames names_;
 };
 
 }  // namespace mpmvv::app
