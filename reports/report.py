@@ -79,8 +79,9 @@ DEFINITIONS = (
 
 def build_report(suite, figure_directory):
     rows, grid_rows = order_rows(suite), gci_rows(suite)
-    sections = [("Cases", "Status from manifest.json; time reached, failure reason, wall time of the time loop, "
-                 "steps and particle count from each results file.", case_table(suite))]
+    sections = [("Cases", "Status from manifest.json; time reached, failure reason, health verdict (for a run by "
+                 "another program, the rules its output let mpmvv judge), wall time of the time loop, steps and "
+                 "particle count from each results file.", case_table(suite))]
     verdicts, gate_error = None, ""
     if suite.expectations:
         try:

@@ -26,16 +26,34 @@ def number(value, spec=".3g"):
     return "-" if value is None or not math.isfinite(value) else format(value, spec)
 
 
+def health_cell(case):
+    """The case's health verdict, and for a run by another program which of the
+    rules could judge it (reports/external-format.md: the J rule needs F, J or
+    volumes; the energy balance, the work done on the body, is never known) and
+    where its probe lines' tracers came from."""
+    health = case.attribute("health", "")
+    if not isinstance(health, str) or not health:
+        return "-"
+    external = case.results.external if case.results is not None else {}
+    if not case.keys.get("external_command") or not external:
+        return health
+    j_rule = str(external.get("J_rule", "")) == "applied"
+    judged = "J ratio, norms" if j_rule else "norms"
+    unjudged = "energy balance" if j_rule else "energy balance, J ratio (no F, J or volume)"
+    tracers = "; tracers placed by mpmvv" if str(external.get("tracers", "")).startswith("interpolated") else ""
+    return f"{health} (judged: {judged}; not judged: {unjudged}{tracers})"
+
+
 def case_table(suite):
     rows, css = [], []
     for c in suite.cases:
         reached = f"{number(c.time_reached)} / {number(c.end_time)}"
         # A case another program ran (external_command): mpmvv does not see its steps.
         steps = "external program" if c.keys.get("external_command") else number(c.attribute("steps"), "g")
-        rows.append([c.id, c.status, reached, "" if c.completed else c.failure_reason, number(c.wall_time_s),
-                     steps, number(c.attribute("particle_count"), "g")])
+        rows.append([c.id, c.status, reached, "" if c.completed else c.failure_reason, health_cell(c),
+                     number(c.wall_time_s), steps, number(c.attribute("particle_count"), "g")])
         css.append(c.status)
-    return Table(["case", "status", "reached / end time [s]", "failure reason", "wall time [s]", "steps",
+    return Table(["case", "status", "reached / end time [s]", "failure reason", "health", "wall time [s]", "steps",
                   "particles"], rows, css)
 
 
