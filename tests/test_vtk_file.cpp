@@ -230,6 +230,19 @@ TEST(VtkFile, ArraysKeepTheSpacingTheyWereWrittenWith) {
   EXPECT_DOUBLE_EQ(s->output_spacing, 1.0);
 }
 
+TEST(ParticleOutput, LatticeReferencePositionsTakeTheCurrentOnesDigits) {
+  // Karamelo's dumps as its adapter writes them: X on the seeding lattice
+  // (4 digits at most), x and the velocity with 6: the writer's 6 digits,
+  // spacing 1e-5, not the lattice's 1e-3; V0 in 17 digits weighs nothing.
+  const fs::path dir = folder("lattice");
+  write(dir / "particles_0.csv", "X,Y,x,y,V0,vx,vy\n"
+                                 "-1.225,-0.225,-1.22446,-0.226121,0.0025000000000000001,-0.0937509,1.1132\n"
+                                 "-1.225,-0.175,-1.22448,-0.177112,0.0025000000000000001,-0.0331417,0.743857\n");
+  const std::optional<OutputState> s = ParticleOutput(dir.string(), "csv", {0.5}).read(0, 0);
+  ASSERT_TRUE(s);
+  EXPECT_DOUBLE_EQ(s->output_spacing, 1e-5);
+}
+
 // What read() says of `text` as an output's particles file `name`; "(read)" when it reads.
 std::string read_message(const std::string& name, const std::string& text) {
   const fs::path dir = folder("plane");

@@ -70,6 +70,7 @@ struct ArraySource {
     std::vector<double> values;
     std::size_t rows = 0;
     double spacing = kDoubleSpacing;  // of the numbers as the file stores them
+    bool text = false;                // counted from text's digits (number_spacing.hpp)
   };
   std::function<std::optional<Rows>(const std::string& name, std::size_t width)> get;
   std::function<std::string(const std::string& name)> spelled;
@@ -93,7 +94,13 @@ void fill_state(OutputState& s, const ArraySource& source, const std::string& wh
     spacing = std::max(spacing, a.spacing);
     return a;
   };
-  ArraySource::Rows reference = differenced(required("reference_position", 2));
+  ArraySource::Rows reference = required("reference_position", 2);
+  ArraySource::Rows current = required("position", 2);
+  // Text's digits bound a writer's precision from below only: seeded
+  // reference positions on a lattice ("-1.225") need fewer digits than the
+  // format gives them. A program writes X as it writes x, so in text the two
+  // take the finer of their spacings (the most digits either shows).
+  if (reference.text && current.text) reference.spacing = current.spacing = std::min(reference.spacing, current.spacing);
   const std::size_t n = reference.rows;
   auto checked = [&](const char* name, ArraySource::Rows a, std::size_t width) {
     if (a.rows != n || a.values.size() != n * width)
@@ -101,8 +108,8 @@ void fill_state(OutputState& s, const ArraySource& source, const std::string& wh
                                             source.spelled(name), n, width, n, source.spelled("reference_position")));
     return std::move(a.values);
   };
-  const std::vector<double> X = checked("reference_position", std::move(reference), 2);
-  const std::vector<double> x = checked("position", differenced(required("position", 2)), 2);
+  const std::vector<double> X = checked("reference_position", differenced(std::move(reference)), 2);
+  const std::vector<double> x = checked("position", differenced(std::move(current)), 2);
   const std::vector<double> V0 = checked("reference_volume", required("reference_volume", 1), 1);
   start_state(s, n);
   for (std::size_t p = 0; p < n; ++p) {
@@ -348,6 +355,7 @@ std::optional<OutputState> ParticleOutput::read_csv(std::size_t k, std::size_t t
     a.rows = given[0]->size();
     a.values.resize(a.rows * width);
     a.spacing = 0.0;
+    a.text = true;
     for (const char* c : columns.at(array)) a.spacing = std::max(a.spacing, t.spacing(named(c)));
     for (std::size_t p = 0; p < a.rows; ++p)
       for (std::size_t c = 0; c < width; ++c) a.values[p * width + c] = (*given[c])[p];
@@ -510,6 +518,7 @@ std::optional<OutputState> ParticleOutput::read_vtk(std::size_t k, std::size_t t
     ArraySource::Rows r;
     r.rows = n;
     r.spacing = a->spacing;
+    r.text = a->text;
     r.values.resize(n * width);
     for (std::size_t p = 0; p < n; ++p)
       for (std::size_t i = 0; i < width; ++i) r.values[p * width + i] = a->values[p * c + pick[i]];

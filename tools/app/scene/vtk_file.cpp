@@ -86,6 +86,7 @@ VtkArray ascii_values(const char* text, const std::string& where) {
     p = end;
   }
   a.spacing = digits_spacing(digits);
+  a.text = true;
   return a;
 }
 
@@ -217,6 +218,7 @@ VtkArray xml_array(const pugi::xml_node& a, const XmlLayout& L, const std::strin
 
 void append(VtkArray& into, const VtkArray& a) {
   into.spacing = into.values.empty() ? a.spacing : std::max(into.spacing, a.spacing);
+  into.text = into.values.empty() ? a.text : into.text || a.text;
   into.components = a.components;
   into.values.insert(into.values.end(), a.values.begin(), a.values.end());
 }
@@ -428,6 +430,7 @@ class LegacyReader {
         digits = std::max(digits, significant_digits(s));
       }
       a.spacing = digits_spacing(digits);
+      a.text = true;
     } else {
       line();  // the rest of the header line
       if (pos_ + n * t.size > text_.size())

@@ -26,6 +26,7 @@ struct VtkArray {
   std::size_t components = 1;
   std::vector<double> values;
   double spacing = kDoubleSpacing;  // relative, of the numbers as stored (number_spacing.hpp)
+  bool text = false;  // spacing counted from digits written as text: the writer's precision is at least that
   std::size_t tuples() const { return components == 0 ? 0 : values.size() / components; }
 };
 
