@@ -48,8 +48,9 @@ LEVELS_CSV_COLUMNS = (
                            "and at round-off)"),
     ("relative_error", "the error over the exact signal the norm measures at that time (NaN where not known; "
                        "error_* and particle_relative_L2_integrated are relative already: signal 1)"),
-    ("roundoff_floor", "the round-off floor, (256 + steps) ulps of the numbers the error is a difference of (and "
-                       "4 spacings of how an external program wrote them), over the same signal: a level whose relative_error is at most this is at round-off "
+    ("roundoff_floor", f"the round-off floor, ({orders.ROUNDOFF_ULPS} + steps) ulps of the numbers the error is a "
+                       f"difference of (and {orders.OUTPUT_SPACING_UNITS} spacings of how an external program wrote "
+                       "them), over the same signal: a level whose relative_error is at most this is at round-off "
                        "(reports/orders.py)"),
     ("settling", "the settling level over the same signal, the largest error the run's distance from its static "
                  "state at the end could leave (scales.py: settling_scale; NaN for a run that does not settle): a "

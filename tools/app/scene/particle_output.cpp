@@ -25,6 +25,25 @@ namespace {
 
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
+// Each array of the layout by mpmvv's name, in the layout's order, with its
+// CSV columns (the stress's three give its four entries), given whole or not
+// at all.
+const std::vector<std::pair<std::string, std::vector<const char*>>> kArrays = {
+    {"reference_position", {"X", "Y"}}, {"position", {"x", "y"}}, {"reference_volume", {"V0"}},
+    {"velocity", {"vx", "vy"}}, {"stress", {"sxx", "sxy", "sxy", "syy"}},
+    {"deformation_gradient", {"F11", "F12", "F21", "F22"}}, {"volume", {"V"}}, {"mass", {"m"}}, {"J", {"J"}}};
+
+const std::vector<const char*>& csv_columns(const std::string& array) {
+  const auto it = std::find_if(kArrays.begin(), kArrays.end(), [&](const auto& a) { return a.first == array; });
+  if (it == kArrays.end()) throw std::logic_error("no array " + array + " in the layout");
+  return it->second;
+}
+
+std::string trimmed(const std::string& s) {
+  const std::size_t a = s.find_first_not_of(" \t\r"), b = s.find_last_not_of(" \t\r");
+  return a == std::string::npos ? std::string() : s.substr(a, b - a + 1);
+}
+
 // Every optional field NaN until given (OutputState).
 void start_state(OutputState& s, std::size_t n) {
   s.P.resize(n);
@@ -145,22 +164,23 @@ void check_tracers(std::size_t given, std::size_t tracers, const std::string& wh
 
 namespace {
 
-// The items each format's files hold under mpmvv's names (external-format.md);
-// VTK's positions are its points, which carry no name.
+// The items each format's files hold under mpmvv's names (external-format.md):
+// the arrays (and the tracers) of HDF5, the point arrays of VTK, whose
+// positions are its points and carry no name, the columns of CSV.
 const std::vector<std::string>& own_names(const std::string& format) {
-  static const std::vector<std::string> arrays = {"reference_position", "position", "reference_volume", "velocity",
-                                                  "stress", "deformation_gradient", "J", "volume", "mass",
-                                                  "tracer_position"};
-  static const std::vector<std::string> point_arrays = {"reference_position", "reference_volume", "velocity", "stress",
-                                                        "deformation_gradient", "J", "volume", "mass"};
-  static const std::vector<std::string> columns = {"X",   "Y",   "x",   "y",   "V0",  "vx", "vy", "sxx", "syy",
-                                                   "sxy", "F11", "F12", "F21", "F22", "J",  "V",  "m"};
-  return format == "csv" ? columns : format == "vtk" ? point_arrays : arrays;
-}
-
-std::string trimmed_text(const std::string& s) {
-  const auto first = s.find_first_not_of(" \t");
-  return first == std::string::npos ? std::string() : s.substr(first, s.find_last_not_of(" \t") - first + 1);
+  static const std::map<std::string, std::vector<std::string>> names = [] {
+    std::map<std::string, std::vector<std::string>> by_format;
+    for (const auto& [array, columns] : kArrays) {
+      by_format["hdf5"].push_back(array);
+      if (array != "position") by_format["vtk"].push_back(array);
+      std::vector<std::string>& csv = by_format["csv"];
+      for (const char* c : columns)
+        if (std::find(csv.begin(), csv.end(), c) == csv.end()) csv.push_back(c);
+    }
+    by_format["hdf5"].push_back("tracer_position");
+    return by_format;
+  }();
+  return names.at(format);
 }
 
 }  // namespace
@@ -171,13 +191,13 @@ OutputNames parse_output_names(const std::string& text, const std::string& forma
   std::size_t start = 0;
   while (start <= text.size()) {
     const std::size_t comma = std::min(text.find(',', start), text.size());
-    const std::string pair = trimmed_text(text.substr(start, comma - start));
+    const std::string pair = trimmed(text.substr(start, comma - start));
     start = comma + 1;
     if (pair.empty()) continue;
     const std::size_t eq = pair.find('=');
     if (eq == std::string::npos)
       throw std::invalid_argument(fmt::format("'{}' is no NAME=FILE_NAME pair (e.g. reference_volume=vol0)", pair));
-    const std::string name = trimmed_text(pair.substr(0, eq)), file = trimmed_text(pair.substr(eq + 1));
+    const std::string name = trimmed(pair.substr(0, eq)), file = trimmed(pair.substr(eq + 1));
     if (std::find(own.begin(), own.end(), name) == own.end()) {
       std::string list;
       for (const std::string& n : own) list += (list.empty() ? "" : ", ") + n;
@@ -207,6 +227,16 @@ std::optional<OutputState> ParticleOutput::read(std::size_t k, std::size_t trace
   return read_hdf5(k, tracers);
 }
 
+namespace {
+
+// The spacing of a dataset's `values` as HDF5 stores them (number_spacing.hpp).
+double stored_spacing(const h5::Group& g, const std::string& dataset, const std::vector<double>& values) {
+  const h5::Group::StoredNumber stored = g.stored_number(dataset);
+  return binary_spacing(stored.floating, stored.bytes, values);
+}
+
+}  // namespace
+
 std::optional<OutputState> ParticleOutput::read_hdf5(std::size_t k, std::size_t tracers) const {
   if (!fs::exists(path_)) return std::nullopt;
   const h5::File file = h5::File::open_read(path_);
@@ -226,8 +256,7 @@ std::optional<OutputState> ParticleOutput::read_hdf5(std::size_t k, std::size_t 
     ArraySource::Rows a;
     a.values = g.read_doubles(dataset, &d);
     a.rows = d.empty() ? 0 : d[0];
-    const h5::Group::StoredNumber stored = g.stored_number(dataset);
-    a.spacing = binary_spacing(stored.floating, stored.bytes, a.values);
+    a.spacing = stored_spacing(g, dataset, a.values);
     return a;
   };
   source.spelled = [&](const std::string& item) { return fmt::format("dataset '{}'", named(item)); };
@@ -239,8 +268,7 @@ std::optional<OutputState> ParticleOutput::read_hdf5(std::size_t k, std::size_t 
     if (d.size() != 2 || d[0] != tracers || d[1] != 2)
       throw ParticleOutputError(fmt::format("{}/{}: must be {} x 2 (the input file's tracers)", where, tracer, tracers));
     for (std::size_t i = 0; i < tracers; ++i) s.tracers.emplace_back(t[2 * i], t[2 * i + 1]);
-    const h5::Group::StoredNumber stored = g.stored_number(tracer);
-    s.output_spacing = std::max(s.output_spacing, binary_spacing(stored.floating, stored.bytes, t));
+    s.output_spacing = std::max(s.output_spacing, stored_spacing(g, tracer, t));
     s.fields.tracers = true;
   }
   s.time = g.has_attribute("time") ? checked_time(g.attribute_double("time"), requested_, k, where) : requested_[k];
@@ -266,11 +294,6 @@ struct CsvTable {
     return it == names.end() ? kDoubleSpacing : digits_spacing(digits[std::size_t(it - names.begin())]);
   }
 };
-
-std::string trimmed(const std::string& s) {
-  const std::size_t a = s.find_first_not_of(" \t\r"), b = s.find_last_not_of(" \t\r");
-  return a == std::string::npos ? std::string() : s.substr(a, b - a + 1);
-}
 
 CsvTable read_csv_table(const std::string& path) {
   std::ifstream f(path);
@@ -325,15 +348,9 @@ std::optional<OutputState> ParticleOutput::read_csv(std::size_t k, std::size_t t
   const std::string path = (fs::path(path_) / fmt::format("particles_{}.csv", k)).string();
   if (!fs::exists(path)) return std::nullopt;
   const CsvTable t = read_csv_table(path);
-  // Each array's columns (the stress's three give its four entries), given
-  // whole or not at all.
-  static const std::map<std::string, std::vector<const char*>> columns = {
-      {"reference_position", {"X", "Y"}}, {"position", {"x", "y"}}, {"reference_volume", {"V0"}},
-      {"velocity", {"vx", "vy"}}, {"stress", {"sxx", "sxy", "sxy", "syy"}},
-      {"deformation_gradient", {"F11", "F12", "F21", "F22"}}, {"volume", {"V"}}, {"mass", {"m"}}, {"J", {"J"}}};
   auto names = [&](const std::string& array) {
     std::vector<std::string> unique;
-    for (const char* c : columns.at(array))
+    for (const char* c : csv_columns(array))
       if (std::find(unique.begin(), unique.end(), named(c)) == unique.end()) unique.push_back(named(c));
     return unique;
   };
@@ -346,7 +363,7 @@ std::optional<OutputState> ParticleOutput::read_csv(std::size_t k, std::size_t t
   };
   source.get = [&](const std::string& array, std::size_t width) -> std::optional<ArraySource::Rows> {
     std::vector<const std::vector<double>*> given;
-    for (const char* c : columns.at(array)) given.push_back(t.find(named(c)));
+    for (const char* c : csv_columns(array)) given.push_back(t.find(named(c)));
     const auto present = std::count_if(given.begin(), given.end(), [](auto* c) { return c != nullptr; });
     if (present == 0) return std::nullopt;
     if (present != std::ptrdiff_t(given.size()))
@@ -356,7 +373,7 @@ std::optional<OutputState> ParticleOutput::read_csv(std::size_t k, std::size_t t
     a.values.resize(a.rows * width);
     a.spacing = 0.0;
     a.text = true;
-    for (const char* c : columns.at(array)) a.spacing = std::max(a.spacing, t.spacing(named(c)));
+    for (const char* c : csv_columns(array)) a.spacing = std::max(a.spacing, t.spacing(named(c)));
     for (std::size_t p = 0; p < a.rows; ++p)
       for (std::size_t c = 0; c < width; ++c) a.values[p * width + c] = (*given[c])[p];
     return a;
