@@ -298,6 +298,13 @@ with tempfile.TemporaryDirectory() as tmp:
     r, _ = run(tmp, "twice-named", "vtk", "vtp", names="volume=v, mass=v")
     check(r.returncode == 2 and "'v' is the file's name of both volume and mass" in r.stderr,
           f"one file name for two items: {r.stderr}")
+    # Names without a program to name the files of: refused, not ignored.
+    r = subprocess.run([MPMVV, "run", str(USER), "--threads", "1", "--quiet", "-o", str(tmp / "nameless.h5"),
+                        "--set", SETS[0], "--set", SETS[1], "--set", "external_names=volume=vol0"],
+                       capture_output=True, text=True, timeout=120)
+    check(r.returncode == 2 and "external_names" in r.stderr and "no external_command" in r.stderr
+          and not (tmp / "nameless.h5").exists(),
+          f"external_names without external_command: {r.returncode}: {r.stderr}")
     r, _ = run(tmp, "bent", "vtk", "vtp", "bent")
     check(r.returncode == 1 and "malformed output" in r.stdout and "the points is not plane strain: z - Z" in r.stdout,
           f"particles moved out of the plane: {r.stdout}")

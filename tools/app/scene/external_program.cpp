@@ -52,7 +52,16 @@ std::vector<KeySpec> external_program_keys() {
 }
 
 std::optional<ExternalProgram> external_program(const Config& config) {
-  if (!config.has("external_command") || config.text("external_command").empty()) return std::nullopt;
+  if (!config.has("external_command")) return std::nullopt;
+  if (config.text("external_command").empty()) {
+    // Names describe an external program's files: without a program they
+    // would be ignored, and a run the user meant for another code would read
+    // as mpmvv's own.
+    if (!config.text("external_names").empty())
+      config.reject("external_names", "it maps the names of an external program's files, and no external_command "
+                                      "names a program (set external_command, or leave external_names out)");
+    return std::nullopt;
+  }
   OutputNames names;
   try {
     names = parse_output_names(config.text("external_names"), config.text("external_format"));
@@ -132,9 +141,12 @@ void write_external_input(const ExternalFiles& files, const Config& config, cons
                           const std::vector<Vec2>& tracer_reference, const std::vector<Vec2>& tracer_start,
                           const std::string& format) {
   // The scene as mpmvv itself would run it: the program is the solver now
-  // (external_format and external_timeout stay, as what the harness asked for).
+  // (external_format and external_timeout stay, as what the harness asked for;
+  // external_names is how the harness reads the program's files, none of the
+  // program's business, and refused without a command).
   Config own = config;
   own.set("external_command", std::string(), Origin{"external program input"});
+  own.set("external_names", std::string(), Origin{"external program input"});
   Json keys = Json::object();
   for (const KeySpec& k : own.specs()) keys[k.name] = json_of(own.value(k.name));
   auto points = [](const std::vector<Vec2>& list) {

@@ -1,8 +1,11 @@
 // What an external program writes back (reports/external-format.md): its
 // particles at each output time, as an HDF5 file of /snapshots/<k> groups
 // (the layout of mpmvv's own results file with particle_fields = "outputs")
-// or a folder of CSV files, read into the solver's particle arrays so that
-// the norms are computed by the same code as for mpmvv's own runs.
+// or a folder of CSV or VTK files, read into the solver's particle arrays so
+// that the norms are computed by the same code as for mpmvv's own runs. The
+// HDF5 and CSV readers are in particle_output.cpp, the VTK one in
+// particle_output_vtk.cpp; what they share, the state filled and checked from
+// a file's arrays, in output_arrays.hpp.
 #pragma once
 
 #include <cstddef>
