@@ -22,7 +22,9 @@ bit; the 12-digit ascii one within 1e-9, its output_spacing 1e-11 (the
 doubles' 2.2e-16). A missing required array, particles moved out of the
 plane and two files for one output time are named. Arrays named as the
 program names them, mapped by external_names, read as the CSV; a name the
-layout lacks, or one file name for two items, is refused.
+layout lacks, or one file name for two items, is refused. A stress written in
+Voigt's order reads as the CSV with external_stress_order, and is refused as
+out of the plane without it.
 
     /usr/bin/python3 tests/external_vtk.py MPMVV   (ctest runs it; exit 1 names what failed)
 """
@@ -181,6 +183,8 @@ for k, t_out in enumerate(inp["output_times"]):
             write_legacy_ascii(path("particles", k, "vtk"), xyz(x), t)
     elif mode == "vtp":
         S6 = np.c_[S[:, 0, 0], S[:, 1, 1], np.zeros(N), S[:, 0, 1], np.zeros(N), np.zeros(N)]
+        if "voigt" in sys.argv[3:]:  # xx, yy, zz, yz, xz, xy (external_stress_order says so)
+            S6 = S6[:, [0, 1, 2, 4, 5, 3]]
         arrays = [("reference_position", xyz(np.c_[X, Y])), ("reference_volume", V0), ("velocity", vel),
                   ("stress", S6), ("deformation_gradient", full(F, 1.0)), ("volume", V)]
         if "renamed" in sys.argv[3:]:  # a code's own names (external_names maps them)
@@ -207,12 +211,13 @@ for k, t_out in enumerate(inp["output_times"]):
 SETS = ["cells=16", "end_time=0.02"]
 
 
-def run(tmp, name, fmt, *args, names=""):
+def run(tmp, name, fmt, *args, names="", order=None):
     output = tmp / f"{name}.h5"
     command = f"/usr/bin/python3 {tmp / 'toy.py'} {{input}} {' '.join(args)}"
     r = subprocess.run([MPMVV, "run", str(USER), "--threads", "1", "--quiet", "-o", str(output), "--set", SETS[0],
                         "--set", SETS[1], "--set", f"external_format={fmt}", "--set", f"external_command={command}",
-                        "--set", f"external_names={names}"],
+                        "--set", f"external_names={names}"]
+                       + (["--set", f"external_stress_order={order}"] if order is not None else []),
                        capture_output=True, text=True, timeout=120)
     return r, output
 
@@ -278,17 +283,34 @@ with tempfile.TemporaryDirectory() as tmp:
         with h5py.File(path) as f:
             check(len(f["errors"]["time"]) == 1, "the output read before the malformed one is kept")
     # A code's own array names, mapped by external_names: the same results.
-    r, path = run(tmp, "renamed", "vtk", "vtp", "renamed",
-                  names="reference_volume=vol0, velocity=velocities,stress = stresses")
-    check(r.returncode == 0, f"renamed arrays: exit {r.returncode}: {r.stdout}{r.stderr}")
-    if r.returncode == 0:
+    def same_as_csv(r, path, what, attribute, value):
+        """The run read the CSV's results bit for bit, and /external records `attribute`."""
+        check(r.returncode == 0, f"{what}: exit {r.returncode}: {r.stdout}{r.stderr}")
+        if r.returncode != 0:
+            return
         got, want = datasets(path), references[""]
         check(sorted(got) == sorted(want) and all(np.array_equal(got[n], want[n], equal_nan=True)
                                                   if isinstance(want[n], np.ndarray) else got[n] == want[n]
                                                   for n in want),
-              "renamed arrays: the results differ from the CSV's")
+              f"{what}: the results differ from the CSV's")
         with h5py.File(path) as f:
-            check(f["external"].attrs["names"].startswith("reference_volume=vol0"), "/external names")
+            check(f["external"].attrs[attribute].startswith(value), f"/external {attribute}")
+
+    r, path = run(tmp, "renamed", "vtk", "vtp", "renamed",
+                  names="reference_volume=vol0, velocity=velocities,stress = stresses")
+    same_as_csv(r, path, "renamed arrays", "names", "reference_volume=vol0")
+    # A stress in Voigt's order, read where external_stress_order puts it: the same results.
+    r, path = run(tmp, "voigt", "vtk", "vtp", "voigt", order="xx, yy, zz, yz, xz, xy")
+    same_as_csv(r, path, "a Voigt-ordered stress", "stress_order", "xx, yy, zz, yz, xz, xy")
+    r, _ = run(tmp, "voigt-unordered", "vtk", "vtp", "voigt")
+    check(r.returncode == 1 and "stress is not plane strain: sigma_xz" in r.stdout,
+          f"a Voigt-ordered stress read in VTK's order: {r.stdout}")
+    r, _ = run(tmp, "voigt-csv", "csv", "csv", order="xx, yy, zz, yz, xz, xy")
+    check(r.returncode == 2 and "external_stress_order" in r.stderr and "external_format is csv" in r.stderr,
+          f"a stress order for CSV files: {r.returncode}: {r.stderr}")
+    r, _ = run(tmp, "voigt-twice", "vtk", "vtp", order="xx, yy, zz, yz, xz, yz")
+    check(r.returncode == 2 and "external_stress_order" in r.stderr and "yz is given twice" in r.stderr,
+          f"a stress order naming a component twice: {r.returncode}: {r.stderr}")
     r, _ = run(tmp, "unmapped", "vtk", "vtp", "renamed")
     check(r.returncode == 1 and "no point array 'vol0'" not in r.stdout and "no point array 'reference_volume'" in r.stdout,
           f"renamed arrays without the map: {r.stdout}")
@@ -299,12 +321,13 @@ with tempfile.TemporaryDirectory() as tmp:
     check(r.returncode == 2 and "'v' is the file's name of both volume and mass" in r.stderr,
           f"one file name for two items: {r.stderr}")
     # Names without a program to name the files of: refused, not ignored.
-    r = subprocess.run([MPMVV, "run", str(USER), "--threads", "1", "--quiet", "-o", str(tmp / "nameless.h5"),
-                        "--set", SETS[0], "--set", SETS[1], "--set", "external_names=volume=vol0"],
-                       capture_output=True, text=True, timeout=120)
-    check(r.returncode == 2 and "external_names" in r.stderr and "no external_command" in r.stderr
-          and not (tmp / "nameless.h5").exists(),
-          f"external_names without external_command: {r.returncode}: {r.stderr}")
+    for key, value in (("external_names", "volume=vol0"), ("external_stress_order", "xx,yy,zz,yz,xz,xy")):
+        output = tmp / f"{key}-without-command.h5"
+        r = subprocess.run([MPMVV, "run", str(USER), "--threads", "1", "--quiet", "-o", str(output),
+                            "--set", SETS[0], "--set", SETS[1], "--set", f"{key}={value}"],
+                           capture_output=True, text=True, timeout=120)
+        check(r.returncode == 2 and key in r.stderr and "no external_command" in r.stderr and not output.exists(),
+              f"{key} without external_command: {r.returncode}: {r.stderr}")
     r, _ = run(tmp, "bent", "vtk", "vtp", "bent")
     check(r.returncode == 1 and "malformed output" in r.stdout and "the points is not plane strain: z - Z" in r.stdout,
           f"particles moved out of the plane: {r.stdout}")

@@ -326,4 +326,55 @@ TEST(OutputNames, EachLayoutMapsItsOwnItems) {
   EXPECT_NE(message("mass=m, mass=n", "vtk").find("'mass' is named twice"), std::string::npos);
 }
 
+// A stress written in Voigt's order (xx, yy, zz, yz, xz, xy) is read, and its
+// plane checked, where external_stress_order puts the components: the same
+// particles as kPolyData's VTK order, and a yz shear out of the plane named
+// as sigma_yz from its Voigt place.
+TEST(StressOrder, ComponentsAreReadWhereTheOrderPutsThem) {
+  using mpmvv::app::parse_stress_order;
+  const app::StressOrder voigt = parse_stress_order(" xx, yy ,zz, zy, XZ, yx");
+  EXPECT_EQ(voigt, (app::StressOrder{0, 1, 2, 5, 3, 4}));
+  EXPECT_EQ(parse_stress_order("xx,yy,zz,xy,yz,xz"), app::kVtkStressOrder);
+  const fs::path dir = folder("voigt");
+  // Written with 6 digits, so that a misplaced shear resolves (tolerance 8e-5 of the in-plane magnitudes).
+  write(dir / "particles_0.vtp", changed("11 22 33 12 0 0  -11 -22 -33 -12 0 0",
+                                         "11.0000 22.0000 33.0000 0 0 12.0000  -11.0000 -22.0000 -33.0000 0 0 -12.0000"));
+  const std::optional<OutputState> s = ParticleOutput(dir.string(), "vtk", {0.5}, {}, voigt).read(0, 0);
+  ASSERT_TRUE(s);
+  EXPECT_EQ(s->P.stress[0](0, 1), 12.0);
+  EXPECT_EQ(s->P.stress[0](1, 0), 12.0);
+  EXPECT_EQ(s->P.stress[1](0, 1), -12.0);
+  EXPECT_EQ(s->P.stress[1](1, 1), -22.0);
+  // Read in VTK's order, the same file's xy (its last place) is VTK's xz:
+  // out of the plane, and refused.
+  try {
+    ParticleOutput(dir.string(), "vtk", {0.5}).read(0, 0);
+    ADD_FAILURE() << "a Voigt stress read in VTK's order was accepted";
+  } catch (const ParticleOutputError& e) {
+    EXPECT_NE(std::string(e.what()).find("is not plane strain: sigma_xz is 12"), std::string::npos) << e.what();
+  }
+  write(dir / "particles_0.vtp", changed("11 22 33 12 0 0  -11 -22 -33 -12 0 0",
+                                         "11.0000 22.0000 33.0000 2.00000 0 12.0000  -11.0000 -22.0000 -33.0000 0 0 -12.0000"));
+  try {
+    ParticleOutput(dir.string(), "vtk", {0.5}, {}, voigt).read(0, 0);
+    ADD_FAILURE() << "a yz shear out of the plane was accepted";
+  } catch (const ParticleOutputError& e) {
+    EXPECT_NE(std::string(e.what()).find("is not plane strain: sigma_yz is 2 at particle 0"), std::string::npos)
+        << e.what();
+  }
+  const auto message = [&](const std::string& text) {
+    try {
+      parse_stress_order(text);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("(parsed)");
+  };
+  EXPECT_NE(message("xx, yy, zz, xy, yz, xy").find("xy is given twice (places 4 and 6)"), std::string::npos);
+  EXPECT_NE(message("xx, yy, zz, xy, yz").find("xz is missing"), std::string::npos);
+  EXPECT_NE(message("xx, yy, zz, xy, yz, xz, xx").find("xx is given twice"), std::string::npos);
+  EXPECT_NE(message("s11, yy, zz, xy, yz, xz").find("'s11' (place 1) is not a stress component"), std::string::npos);
+  EXPECT_NE(message("").find("'' (place 1) is not a stress component"), std::string::npos);
+}
+
 }  // namespace

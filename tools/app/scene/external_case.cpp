@@ -94,7 +94,7 @@ class ExternalCase final : public SceneCase {
       return finish(o, 0, "external program failed", e.what());
     }
     o.wall_seconds = end_.seconds;
-    const ParticleOutput output(files_.output, program_.format, loop_.output_times, program_.names);
+    const ParticleOutput output(files_.output, program_.format, loop_.output_times, program_.names, program_.stress_order);
     const std::size_t count = loop_.output_times.size();
     std::size_t k = 0;
     for (; k < count; ++k) {
@@ -185,6 +185,7 @@ class ExternalCase final : public SceneCase {
     g.set_attribute("command", command_);
     g.set_attribute("format", program_.format);
     g.set_attribute("names", config_.text("external_names"));
+    g.set_attribute("stress_order", config_.text("external_stress_order"));
     g.set_attribute("output", files_.output);
     g.set_attribute("input", files_.input);
     g.set_attribute("log", files_.log);

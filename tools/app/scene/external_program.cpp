@@ -26,6 +26,12 @@ namespace mpmvv::app {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+constexpr const char* kVtkStressOrderText = "xx, yy, zz, xy, yz, xz";
+
+}  // namespace
+
 std::vector<KeySpec> external_program_keys() {
   const double inf = std::numeric_limits<double>::infinity();
   return {
@@ -44,6 +50,11 @@ std::vector<KeySpec> external_program_keys() {
        "by commas, NAME a dataset or point array of the hdf5 and vtk layouts or a column of the csv one "
        "(e.g. \"reference_volume=vol0, velocity=velocities\"; reports/external-format.md)",
        -inf, inf},
+      {"external_stress_order", KeyKind::text, std::string(kVtkStressOrderText),
+       "the order in which the external program's VTK files write a symmetric stress of 6 components: xx, yy, zz, "
+       "xy, yz, xz each once, separated by commas (VTK's order, the default; Voigt's is \"xx, yy, zz, yz, xz, xy\"; "
+       "reports/external-format.md)",
+       -inf, inf},
       {"external_timeout", KeyKind::real, 0.0,
        "seconds after which the external program is ended and the case fails (0: no limit of its own; a suite's "
        "time-out still applies)",
@@ -60,16 +71,30 @@ std::optional<ExternalProgram> external_program(const Config& config) {
     if (!config.text("external_names").empty())
       config.reject("external_names", "it maps the names of an external program's files, and no external_command "
                                       "names a program (set external_command, or leave external_names out)");
+    if (config.text("external_stress_order") != kVtkStressOrderText)
+      config.reject("external_stress_order", "it orders the stress in an external program's files, and no "
+                                             "external_command names a program (set external_command, or leave "
+                                             "external_stress_order out)");
     return std::nullopt;
   }
-  OutputNames names;
+  ExternalProgram program{config.text("external_command"), config.text("external_format"),
+                          config.real("external_timeout")};
   try {
-    names = parse_output_names(config.text("external_names"), config.text("external_format"));
+    program.names = parse_output_names(config.text("external_names"), program.format);
   } catch (const std::invalid_argument& e) {
     config.reject("external_names", e.what());
   }
-  return ExternalProgram{config.text("external_command"), config.text("external_format"),
-                         config.real("external_timeout"), std::move(names)};
+  try {
+    program.stress_order = parse_stress_order(config.text("external_stress_order"));
+  } catch (const std::invalid_argument& e) {
+    config.reject("external_stress_order", e.what());
+  }
+  // Only VTK files hold a 6-component stress; another order would go unused.
+  if (program.stress_order != kVtkStressOrder && program.format != "vtk")
+    config.reject("external_stress_order", fmt::format("it orders a 6-component stress of VTK files, and "
+                                                       "external_format is {}, whose stress has no such order",
+                                                       program.format));
+  return program;
 }
 
 ExternalFiles external_files(const std::string& results_path, const std::string& format) {
@@ -142,11 +167,13 @@ void write_external_input(const ExternalFiles& files, const Config& config, cons
                           const std::string& format) {
   // The scene as mpmvv itself would run it: the program is the solver now
   // (external_format and external_timeout stay, as what the harness asked for;
-  // external_names is how the harness reads the program's files, none of the
-  // program's business, and refused without a command).
+  // external_names and external_stress_order are how the harness reads the
+  // program's files, none of the program's business, and refused without a
+  // command).
   Config own = config;
   own.set("external_command", std::string(), Origin{"external program input"});
   own.set("external_names", std::string(), Origin{"external program input"});
+  own.set("external_stress_order", std::string(kVtkStressOrderText), Origin{"external program input"});
   Json keys = Json::object();
   for (const KeySpec& k : own.specs()) keys[k.name] = json_of(own.value(k.name));
   auto points = [](const std::vector<Vec2>& list) {

@@ -24,9 +24,11 @@ struct ExternalProgram {
   std::string format;   // "hdf5", "csv" or "vtk": what the program writes at {output}
   double timeout = 0.0;  // seconds; 0: none of its own
   OutputNames names;    // external_names: how its files spell mpmvv's items
+  StressOrder stress_order = kVtkStressOrder;  // external_stress_order: a 6-component VTK stress's order
 };
 // The program `config` names, or none (external_command = "": mpmvv's own
-// solver). A malformed external_names is refused (ConfigError naming it).
+// solver). A malformed external_names or external_stress_order is refused
+// (ConfigError naming it), and so is either without a command.
 std::optional<ExternalProgram> external_program(const Config& config);
 
 // Where a case's files go (absolute paths), beside its results file RESULTS.h5: RESULTS.input.json

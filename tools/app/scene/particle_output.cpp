@@ -1,6 +1,7 @@
 #include "particle_output.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -87,8 +88,42 @@ OutputNames parse_output_names(const std::string& text, const std::string& forma
   return names;
 }
 
-ParticleOutput::ParticleOutput(std::string path, std::string format, std::vector<double> requested, OutputNames names)
-    : path_(std::move(path)), format_(std::move(format)), requested_(std::move(requested)), names_(std::move(names)) {}
+StressOrder parse_stress_order(const std::string& text) {
+  static const std::map<std::string, std::size_t> component = {{"xx", 0}, {"yy", 1}, {"zz", 2}, {"xy", 3}, {"yx", 3},
+                                                               {"yz", 4}, {"zy", 4}, {"xz", 5}, {"zx", 5}};
+  static const char* const names[6] = {"xx", "yy", "zz", "xy", "yz", "xz"};
+  constexpr std::size_t unset = 6;
+  StressOrder order;
+  order.fill(unset);
+  std::size_t place = 0, start = 0;
+  while (start <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', start), text.size());
+    std::string name = trimmed(text.substr(start, comma - start));
+    start = comma + 1;
+    for (char& c : name) c = char(std::tolower(static_cast<unsigned char>(c)));
+    const auto it = component.find(name);
+    if (it == component.end())
+      throw std::invalid_argument(fmt::format("'{}' (place {}) is not a stress component: the six are xx, yy, zz, xy, "
+                                              "yz, xz (yx, zy, zx for the last three), separated by commas",
+                                              name, place + 1));
+    if (order[it->second] != unset)
+      throw std::invalid_argument(fmt::format("{} is given twice (places {} and {})", names[it->second],
+                                              order[it->second] + 1, place + 1));
+    if (place == 6) throw std::invalid_argument("more than six components");
+    order[it->second] = place++;
+  }
+  for (std::size_t i = 0; i < 6; ++i)
+    if (order[i] == unset) throw std::invalid_argument(fmt::format("{} is missing: each of the six is given once", names[i]));
+  return order;
+}
+
+ParticleOutput::ParticleOutput(std::string path, std::string format, std::vector<double> requested, OutputNames names,
+                               StressOrder stress_order)
+    : path_(std::move(path)),
+      format_(std::move(format)),
+      requested_(std::move(requested)),
+      names_(std::move(names)),
+      stress_order_(stress_order) {}
 
 std::string ParticleOutput::named(const std::string& own) const {
   const auto it = names_.find(own);

@@ -8,6 +8,7 @@
 // a file's arrays, in output_arrays.hpp.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <map>
 #include <optional>
@@ -57,11 +58,24 @@ using OutputNames = std::map<std::string, std::string>;
 // file's name given twice).
 OutputNames parse_output_names(const std::string& text, const std::string& format);
 
+// Where a symmetric stress's 6 components stand in a program's VTK arrays
+// (external_stress_order): order[i] is the place of component i of VTK's
+// order xx, yy, zz, xy, yz, xz.
+using StressOrder = std::array<std::size_t, 6>;
+inline constexpr StressOrder kVtkStressOrder = {0, 1, 2, 3, 4, 5};
+
+// "xx, yy, zz, yz, xz, xy" (Voigt's order), each of the six components once,
+// yx, zy and zx standing for xy, yz and xz; throws std::invalid_argument
+// naming a component that is unknown, repeated or missing.
+StressOrder parse_stress_order(const std::string& text);
+
 class ParticleOutput {
  public:
   // `path` and `format` as the input file named them; `requested` the output
-  // times; `names` how the files spell the items they are not named as.
-  ParticleOutput(std::string path, std::string format, std::vector<double> requested, OutputNames names = {});
+  // times; `names` how the files spell the items they are not named as;
+  // `stress_order` the order of a 6-component VTK stress.
+  ParticleOutput(std::string path, std::string format, std::vector<double> requested, OutputNames names = {},
+                 StressOrder stress_order = kVtkStressOrder);
   // The output for requested time k, or none when the program wrote none
   // for it; throws ParticleOutputError when what it wrote is malformed
   // (a missing required item, a row count or a column that does not match,
@@ -77,6 +91,7 @@ class ParticleOutput {
   std::string path_, format_;
   std::vector<double> requested_;
   OutputNames names_;
+  StressOrder stress_order_;
 };
 
 }  // namespace mpmvv::app

@@ -63,8 +63,8 @@ std::optional<double> vtk_time(const VtkPoints& v, const std::string& path) {
 constexpr double kPlaneTolerance = 1e-9;
 constexpr double kPlaneSpacings = 8.0;
 
-void check_plane(const VtkPoints& v, const std::string& path,
-                 const std::function<std::string(const char*)>& named) {
+void check_plane(const VtkPoints& v, const std::string& path, const std::function<std::string(const char*)>& named,
+                 const StressOrder& o) {
   struct Component {
     std::size_t index;
     double target;  // its plane-strain value
@@ -117,7 +117,7 @@ void check_plane(const VtkPoints& v, const std::string& path,
     check("stress", *S, {0, 1, 3, 4, 8}, {{2, 0.0, "sigma_xz"}, {5, 0.0, "sigma_yz"}, {6, 0.0, "sigma_zx"}, {7, 0.0, "sigma_zy"}},
           nullptr);
   if (const VtkArray* S = array("stress", 6))
-    check("stress", *S, {0, 1, 2, 3}, {{4, 0.0, "sigma_yz"}, {5, 0.0, "sigma_xz"}}, nullptr);
+    check("stress", *S, {o[0], o[1], o[2], o[3]}, {{o[4], 0.0, "sigma_yz"}, {o[5], 0.0, "sigma_xz"}}, nullptr);
 }
 
 }  // namespace
@@ -131,8 +131,9 @@ std::optional<OutputState> ParticleOutput::read_vtk(std::size_t k, std::size_t t
     return array == "position" ? std::string("points") : fmt::format("point array '{}'", named(array));
   };
   // VTK's tuples hold 3 components where mpmvv's plane holds 2: a vector's
-  // z and a tensor's third row and column are dropped; a symmetric tensor of
-  // 6 is VTK's order xx, yy, zz, xy, yz, xz.
+  // z and a tensor's third row and column are dropped; a symmetric stress of
+  // 6 is in VTK's order xx, yy, zz, xy, yz, xz unless external_stress_order
+  // says otherwise.
   source.get = [&](const std::string& array, std::size_t width) -> std::optional<ArraySource::Rows> {
     const VtkArray* a = &v.points;
     if (array != "position") {
@@ -149,7 +150,8 @@ std::optional<OutputState> ParticleOutput::read_vtk(std::size_t k, std::size_t t
     } else if (width == 4 && c == 9) {
       pick = {0, 1, 3, 4};
     } else if (width == 4 && c == 6 && array == "stress") {
-      pick = {0, 3, 3, 1};
+      const StressOrder& o = stress_order_;
+      pick = {o[0], o[3], o[3], o[1]};
     } else {
       throw ParticleOutputError(fmt::format("{}: {} has {} components; mpmvv reads {}", *path, source.spelled(array), c,
                                             width == 1 ? "1" : width == 2 ? "2 or 3" : array == "stress" ? "4, 6 or 9" : "4 or 9"));
@@ -165,7 +167,7 @@ std::optional<OutputState> ParticleOutput::read_vtk(std::size_t k, std::size_t t
   };
   OutputState s;
   fill_state(s, source, *path);
-  check_plane(v, *path, [&](const char* array) { return named(array); });
+  check_plane(v, *path, [&](const char* array) { return named(array); }, stress_order_);
   if (const auto tracer_path = vtk_file_of(path_, fmt::format("tracers_{}", k))) {
     const VtkPoints t = vtk_points(*tracer_path);
     check_tracers(t.points.tuples(), tracers, *tracer_path);
