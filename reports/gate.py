@@ -18,7 +18,11 @@ expectation holds for a series when
   fitted order. An expectation on max_error alone is not affected;
 * max over the levels of E / h^order <= max_error_constant (when given);
 * every usable level's E <= max_error (when given; an expectation gives an
-  order with its tolerance, or max_error, or both);
+  order with its tolerance, or max_error, or both, or at_roundoff);
+* every usable level's E is at round-off (when at_roundoff = true: a patch
+  test, whose motion the method reproduces): above zero and at most the
+  round-off floor; a level whose floor is not known (reports/scales.py has
+  no size for the norm) fails, named;
 * every level's case completed (when must_complete, the default), that is
   neither failed nor lost its solution (the results file's health verdict);
 * at least two levels are usable (have a finite error at that time, and not
@@ -98,7 +102,8 @@ def check_series(number, expect, series):
     # An order fitted through a level whose error rounding, or the solver's
     # settling short of the static state, alone can explain measures that: such
     # an order is never passed (reports/orders.py).
-    checks = roundoff_checks(levels, expect["norm"], expect.get("time")) if has_order else []
+    at_roundoff = bool(expect.get("at_roundoff", False))
+    checks = roundoff_checks(levels, expect["norm"], expect.get("time")) if has_order or at_roundoff else []
     floor = floor_kind(checks)
     order = float(expect["order"]) if has_order else float("nan")
     tolerance = float(expect["tolerance"]) if has_order else float("nan")
@@ -117,6 +122,8 @@ def check_series(number, expect, series):
         if not good:
             left_out = [f"{series.refine}={l.value}: {l.reason}" for l in levels if l.reason]
             reasons.append("no usable level" + (f" ({'; '.join(left_out)})" if left_out else ""))
+    if at_roundoff:
+        reasons.extend(_roundoff_reasons(series, levels, checks, expect["norm"]))
     if not has_order:
         pass
     elif len(good) < 2:
@@ -169,6 +176,25 @@ def check_series(number, expect, series):
                    floor)
 
 
+def _roundoff_reasons(series, levels, checks, norm):
+    """Why the usable levels' errors are not all at round-off (at_roundoff), each named."""
+    good = usable(levels)
+    if not good:
+        left_out = [f"{series.refine}={l.value}: {l.reason}" for l in levels if l.reason]
+        return ["no usable level" + (f" ({'; '.join(left_out)})" if left_out else "")]
+    reasons = []
+    for level, check in zip(good, checks):
+        where = f"{series.refine}={level.value}"
+        if check is None or not math.isfinite(check.floor) or not check.floor > 0.0:
+            reasons.append(f"{where}: no round-off floor is known for {norm}")
+        elif not level.error > 0.0:
+            reasons.append(f"{where}: the error is exactly zero (does the run measure {norm}?)")
+        elif not check.at_roundoff:
+            reasons.append(f"{where}: E = {level.error:.3g} is {level.error / check.floor:.3g} times the round-off "
+                           f"floor {check.floor:.3g}")
+    return reasons
+
+
 def _level_outcome(series, level):
     if level.case is None:
         return level.reason
@@ -219,6 +245,10 @@ def verdict_row(verdict):
     if "max_error" in expect:
         largest = max((l.error for l in verdict.levels if not l.reason), default=float("nan"))
         constant = ("-" if not math.isfinite(largest) else f"E = {largest:.3g}") + f" <= {expect['max_error']:g}"
+    if expect.get("at_roundoff", False):
+        expected = "round-off"
+        largest = max((l.error for l in verdict.levels if not l.reason), default=float("nan"))
+        constant = ("-" if not math.isfinite(largest) else f"E = {largest:.3g}") + " <= floor"
     return [
         str(verdict.number),
         expect["study"],

@@ -8,7 +8,7 @@ beside the table, with the same verdicts (reports/gate.py).
 JSON: {"suite", "expectations", "holds", "verdicts": [{"number", "study",
 "series", "norm", "time", "status", "observed": {"order", "ci_low", "ci_high",
 "error_constant", "floor"}, "expected": {"order", "tolerance", "max_error",
-"max_error_constant", "must_complete"}, "levels": [{"value", "h", "error",
+"max_error_constant", "at_roundoff", "must_complete"}, "levels": [{"value", "h", "error",
 "used", "reason", "case"}], "reasons", "notes", "warnings"}]}; a number
 that is not finite (no fit, an unusable level) is null.
 """
@@ -42,6 +42,7 @@ def _expected(expect):
     return {"order": _number(expect.get("order")), "tolerance": _number(expect.get("tolerance")),
             "max_error": _number(expect.get("max_error")),
             "max_error_constant": _number(expect.get("max_error_constant")),
+            "at_roundoff": bool(expect.get("at_roundoff", False)),
             "must_complete": bool(expect.get("must_complete", True))}
 
 

@@ -16,6 +16,8 @@ DISPLACEMENT_NORMS = ("particle_L1", "particle_L2", "particle_Linf")
 # /errors columns that are already relative to the exact value they measure
 # (results-format.md): their exact signal is 1, in their own unit.
 RELATIVE_NORMS = ("particle_relative_L2_integrated",)
+# The deformation gradient's error, against the size of F's own entries.
+DEFORMATION_NORM = "particle_deformation_L2"
 RELATIVE_NORM_PREFIX = "error_"
 
 
@@ -59,20 +61,38 @@ def exact_signal_fraction(case, norm, time):
     return float(signal[index]) / largest
 
 
-def _strain_size(case):
-    """The largest in-plane |F - I| entry over the particles at the end of the run:
-    a strain, and a stress E (F - I), is formed from entries of F near 1, so its
-    rounding is ulps of 1, not of the strain. None where the file does not hold F."""
+def _end_deformation(case):
+    """The particles' in-plane F at the end of the run (N x 2 x 2), None where the
+    file does not hold it."""
     try:
         with h5py.File(case.results_path, "r") as f:
             F = f.get("particles/deformation_gradient")
             if not isinstance(F, h5py.Dataset) or F.size == 0:
                 return None
-            F = np.asarray(F[:], float).reshape(-1, 2, 2)
+            return np.asarray(F[:], float).reshape(-1, 2, 2)
     except (OSError, KeyError, ValueError, TypeError):
+        return None
+
+
+def _strain_size(case):
+    """The largest in-plane |F - I| entry over the particles at the end of the run:
+    a strain, and a stress E (F - I), is formed from entries of F near 1, so its
+    rounding is ulps of 1, not of the strain. None where the file does not hold F."""
+    F = _end_deformation(case)
+    if F is None:
         return None
     strain = float(np.max(np.abs(F - np.eye(2))))
     return strain if math.isfinite(strain) and strain > 0.0 else None
+
+
+def _deformation_size(case):
+    """The largest |F| entry at the end of the run, F_33 = 1 included: the size
+    of the numbers particle_deformation_L2 is a difference of."""
+    F = _end_deformation(case)
+    if F is None:
+        return None
+    size = max(1.0, float(np.max(np.abs(F))))
+    return size if math.isfinite(size) else None
 
 
 def _coordinate_size(case, norm):
@@ -104,10 +124,11 @@ def error_scale(case, norm, time):
     """(S, M) for the error `norm` at output time `time`: S the exact signal it
     measures there (the mean |exact| on an L1_<line> norm's line, the RMS exact
     displacement for particle_L1, _L2, _Linf; 1 for an error already relative to
-    its exact value: error_* and particle_relative_L2_integrated), M the size of
-    the numbers the error is a difference of (_coordinate_size; 1 for a relative
-    error, 1 / strain for a relative error of a strain or stress, _strain_size),
-    in the norm's unit. The round-off floor of reports/orders.py is
+    its exact value: error_* and particle_relative_L2_integrated; F's largest
+    entry for particle_deformation_L2), M the size of the numbers the error is a
+    difference of (_coordinate_size; 1 for a relative error, 1 / strain for a
+    relative error of a strain or stress, _strain_size; F's largest entry,
+    _deformation_size), in the norm's unit. The round-off floor of reports/orders.py is
     measured with them. None where either is not known."""
     if case.results is None:
         return None
@@ -121,6 +142,12 @@ def error_scale(case, norm, time):
             strain = _strain_size(case)
             return 1.0, 1.0 / min(strain, 1.0) if strain is not None else 1.0
         return 1.0, 1.0
+    if norm == DEFORMATION_NORM:
+        # F's error against F's own size: the signal and the numbers are F's entries.
+        if norm not in case.results.errors:
+            return None
+        size = _deformation_size(case)
+        return (size, size) if size is not None else None
     series = _exact_signal_series(case, norm)
     if series is None:
         return None

@@ -361,3 +361,39 @@ def test_an_external_programs_written_digits_raise_the_floor(tmp_path):
         [check] = roundoff_checks([Level(by_id[doubles], None, 1.0 / 16, 1e-5, "")], "particle_L2")
         assert check.floor < 4 * 356 * 2.220446049250313e-16
         assert error_floor_kind(by_id[doubles], "particle_L2", 1.0, 1e-5) is None
+
+
+AT_ROUNDOFF_EXPECTATIONS = """
+[[expect]]
+study = "roundoff"
+norm = "L1_theta0"
+levels = [64, 128]
+at_roundoff = true
+
+[[expect]]
+study = "roundoff"
+norm = "L1_theta0"
+at_roundoff = true
+
+[[expect]]
+study = "small"
+norm = "particle_L2"
+at_roundoff = true
+"""
+
+
+def test_at_roundoff_holds_only_where_every_level_is_at_the_floor(tmp_path, capsys):
+    """Requirement: at_roundoff (a patch test) holds when every usable level's error
+    is at most its round-off floor (conftest.roundoff_cases: the 64- and 128-cell
+    L1 errors, 1e-13 and 2.5e-14 rad, within the floor 2.48e-13 rad), and fails
+    naming each level above it and by how much: the 32-cell 4e-13 rad, and every
+    level of the same errors on a body a billion times smaller."""
+    directory = write_suite_directory(tmp_path / "suite", ROUNDOFF_SUITE + AT_ROUNDOFF_EXPECTATIONS, roundoff_cases())
+    status, out, _ = run_gate(directory, capsys)
+    rows = {r.split()[0]: r for r in rows_of(out)}
+    assert "PASS" in rows["1"] and "round-off" in rows["1"] and "E = 1e-13 <= floor" in rows["1"]
+    assert "FAIL" in rows["2"] and "cells=32: E = 4e-13 is 1.61 times the round-off floor 2.48e-13" in rows["2"]
+    assert "cells=64" not in rows["2"].split("FAIL")[1]
+    assert "FAIL" in rows["3"] and "cells=128: E = 2.5e-14 is 3.16e+08 times the round-off floor 7.9e-23" in rows["3"]
+    assert status == 1 and "2 of 3 expectations fell short" in out
+

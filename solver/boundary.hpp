@@ -16,6 +16,7 @@
 #include "model.hpp"
 #include "parallel.hpp"
 #include "particles.hpp"
+#include "traction.hpp"
 
 namespace mpmvv {
 
@@ -152,7 +153,9 @@ inline double damping_power(const GridGeometry& grid, const GridFields& g, doubl
 
 // The optional stages of a scene's step; what it leaves empty is absent.
 struct SceneStages {
-  std::shared_ptr<BodyForce> body_force;    // a body force, or tractions on boundary particles
+  std::shared_ptr<BodyForce> body_force;    // a body force per unit mass
+  // Tractions on the sides of the boundary particles' domains (traction.hpp).
+  std::shared_ptr<BoundaryTraction> traction;
   std::vector<NodeConstraint> constraints;  // prescribed motion of grid nodes
   // Points where the grid motion, read with the method's grid basis, is held
   // at rest (rest_points.hpp): a boundary the nodes do not lie on.

@@ -180,7 +180,12 @@ RunOutcome run_time_loop(Stepper& stepper, const TimeLoopOptions& options, RunOb
 
     // After the last step only the health counts: no step is prepared.
     const bool last = lands && s.next_output + 1 == options.output_times.size();
-    scan = last ? stepper.scan() : stepper.prepare_step(s.t);
+    try {
+      scan = last ? stepper.scan() : stepper.prepare_step(s.t);
+    } catch (const std::runtime_error& e) {
+      stop_with("stage failed", e.what());  // the map that prepares the next step, as a step's stage above
+      break;
+    }
     if (scan.first_unhealthy < n()) {
       fail(scan);
       break;

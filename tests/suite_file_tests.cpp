@@ -102,6 +102,13 @@ TEST(SuiteFile, MistakesNameFileLineAndKey) {
       {study + "sweep = { cells = [32, 64] }\n[[expect]]\nstudy = \"a\"\nnorm = \"L1_theta0\"\norder = 2\n"
                "tolerance = 0.1\ninterval_within_band = 1\n",
        "'interval_within_band' must be true or false"},
+      {study + "sweep = { cells = [32, 64] }\n[[expect]]\nstudy = \"a\"\nnorm = \"L1_theta0\"\norder = 2\n"
+               "tolerance = 0.1\nat_roundoff = true\n",
+       "'at_roundoff' asks for errors at round-off, where no order can be observed"},
+      {study + "sweep = { cells = [32, 64] }\n[[expect]]\nstudy = \"a\"\nnorm = \"L1_theta0\"\nat_roundoff = 1\n",
+       "s.toml:8: [[expect]]: 'at_roundoff' must be true or false"},
+      {study + "sweep = { cells = [32, 64] }\n[[expect]]\nstudy = \"a\"\nnorm = \"L1_theta0\"\nat_roundoff = false\n",
+       "[[expect]] needs 'order' (a number), or 'max_error' or 'at_roundoff = true' alone"},
       {study + "set = { inner_radius = 1.3 }\n", "key 'outer_radius': must exceed inner_radius = 1.3 (from"},
       {study + "sweep = { cells = [32, 64] }\n[[reference]]\nsource = \"x\"\nstudy = \"a\"\nquantity = \"time_reached\"\n"
                "columns = [\"cells\"]\nrows = [[32, 0.4], [128, 0.3]]\n",

@@ -116,6 +116,22 @@ void check_explicit_options(const Model& model, const SolverOptions& options, co
     if (!stages.rest_points.empty())
       throw std::invalid_argument("rest points serve one body (each body's grid field would need its own)");
   }
+  if (stages.traction) {
+    // The sides are placed by x_p + F_p (A - X_p) and shared by the grid's
+    // bilinear basis or CPDI's corners (traction.hpp).
+    if (options.geometry != Geometry::plane_strain)
+      throw std::invalid_argument("boundary tractions are plane strain only (r-z would weigh each side by its radius)");
+    if (bspline)
+      throw std::invalid_argument(fmt::format("boundary tractions are shared by the grid's bilinear basis, which method {} "
+                                              "does not interpolate with", to_string(options.method)));
+    if (options.cpdi_domain == CpdiDomain::corners)
+      throw std::invalid_argument("boundary tractions place a domain's side by F_p, and corner domains move their "
+                                  "corners apart from it: use cpdi_domain = \"convected\"");
+    if (stages.second_body > 0) throw std::invalid_argument("boundary tractions serve one body");
+    for (const BoundaryEdge& e : stages.traction->edges())
+      if (e.particle >= n)
+        throw std::invalid_argument(fmt::format("a boundary traction names particle {}, beyond the {} seeded", e.particle, n));
+  }
   for (const NodeConstraint& c : stages.constraints) {
     if (c.axis != 0 && c.axis != 1) throw std::invalid_argument("a node constraint's axis is 0 (x) or 1 (y)");
     if (!c.displacement) throw std::invalid_argument("a node constraint needs its displacement u(t)");

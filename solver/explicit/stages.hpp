@@ -40,6 +40,7 @@ class ExplicitStages : public Stepper {
         viscosity_{settings.viscosity_linear, settings.viscosity_quadratic},
         materials_{material, std::move(second_material), stages.second_material_from},
         body_force_(std::move(stages.body_force)),
+        traction_(std::move(stages.traction)),
         grid_(model_.grid, stages, settings.fault == SolverFault::swapped_walls),
         bodies_(stages.second_body, model_.grid.node_count(), max_threads()) {
     buffers_.resize(max_threads(), model_.grid.node_count());
@@ -48,6 +49,7 @@ class ExplicitStages : public Stepper {
       body_force_->prepare(model_.particles);
       model_.particles.body_force.assign(model_.particles.size(), Vec2::Zero());
     }
+    if (traction_) traction_force_.resize(traction_->edges().size());
     if (settings_.scheme == Scheme::musl) next_position_.resize(model_.particles.size());
     // The affine part starts at zero: the first map is FLIP's. (pic-velocity
     // reads the grid's velocity as APIC does and never maps the affine part.)
@@ -82,10 +84,12 @@ class ExplicitStages : public Stepper {
       if (settings_.scheme == Scheme::usl) {
         stencils_.resize(model_.particles.size());
         map_with_forces(StencilRecorder<Shape>{shape, stencils_.data()}, fields_, {}, scan);
+        add_tractions(t);
         return;
       }
     }
     map_with_forces(shape, fields_, {}, scan);
+    add_tractions(t);
   }
 
   // The map, unless prepare_step made it for this step.
@@ -114,6 +118,24 @@ class ExplicitStages : public Stepper {
       particles_to_grid<kInternalForce | kBodyForce>(shape, model_.particles, buffers_, fields_);
     else
       particles_to_grid<kInternalForce>(shape, model_.particles, buffers_, fields_);
+    add_tractions(t);
+  }
+
+  // The boundary tractions at t on the grid (traction.hpp), shared as the
+  // method forms its internal force: CPDI's corner interpolation, or the
+  // grid basis itself (under the total formulation, the reference basis's).
+  void add_tractions(double t) {
+    if (!traction_) return;
+    constexpr bool total = requires { Shape::total_lagrangian; };
+    constexpr bool corners = [] {
+      if constexpr (total)
+        return decltype(std::declval<Shape>().reference)::gradients_beyond_grid_basis;
+      else
+        return Shape::gradients_beyond_grid_basis;
+    }();
+    traction_->evaluate(t, traction_force_);
+    tractions_to_grid(model_.grid, model_.particles, traction_->edges(), traction_force_,
+                      corners ? TractionRule::corners : TractionRule::exact, total, traction_shares_, fields_);
   }
 
   // The velocity transfer is chosen here, once per stage: under APIC every
@@ -232,9 +254,11 @@ class ExplicitStages : public Stepper {
   }
   GridBooks books() { return {ledger_, reactions_, contact_forces_}; }
 
-  // The body force's work over the step.
+  // The body force's and the tractions' work over the step (the ledger's
+  // body work holds both; results-format.md).
   void book_body_work(double dt) {
     if (body_force_) ledger_.body += dt * body_force_power(model_.particles);
+    if (traction_) ledger_.body += dt * traction_power(traction_shares_, fields_);
   }
 
   void evaluate_body_force(double t) {
@@ -277,6 +301,9 @@ class ExplicitStages : public Stepper {
   std::vector<Stencil<Shape::stencil_size>> stencils_;
   Materials<Material> materials_;
   std::shared_ptr<BodyForce> body_force_;
+  std::shared_ptr<BoundaryTraction> traction_;
+  std::vector<Vec2> traction_force_;        // each side's force at the last map
+  std::vector<NodeForce> traction_shares_;  // the nodes' shares of it, for its work
   GridConditions<Shape> grid_;  // what the scene does to the grid's motion
   SecondBody bodies_;  // two bodies in contact (contact.hpp); bodies_.first = 0: one body
   ScatterBuffers buffers_;

@@ -329,6 +329,7 @@ std::unique_ptr<Stepper> make_static_stepper(Model model, const SolverOptions& o
     throw std::invalid_argument("a second material serves the explicit step only");
   if (!stages.rest_points.empty())
     throw std::invalid_argument("rest points serve the explicit step only (rims = \"held\" holds the nodes)");
+  if (stages.traction) throw std::invalid_argument("boundary tractions serve the explicit step only");
   switch (options.method) {
     case Method::linear: return make_for_shape<LinearShape>(std::move(model), material, std::move(stages), o);
     case Method::gimp: return make_for_shape<GimpShapeT<Geometry::plane_strain>>(std::move(model), material, std::move(stages), o);

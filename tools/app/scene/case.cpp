@@ -151,8 +151,9 @@ class Case final : public SceneCase, private RunObserver {
   Geometry geometry() const override { return setup_.geometry; }
   std::string body_force_kind() const override {
     if (setup_.force_free) return setup_.loading.empty() ? "none" : "none; " + setup_.loading;
-    const std::string kind = setup_.fast_body_force ? "closed form" : "derived";
-    return force_quadrature() == mms::ForceQuadrature::domain ? kind + ", mean over each particle's domain" : kind;
+    std::string kind = setup_.fast_body_force ? "closed form" : "derived";
+    if (force_quadrature() == mms::ForceQuadrature::domain) kind += ", mean over each particle's domain";
+    return setup_.loading.empty() ? kind : kind + "; " + setup_.loading;
   }
   Measurements measurements() const override {
     if (!stepper_) return {};

@@ -10,13 +10,15 @@
 // of (R, Z), the formulas u_r, u_z of R, Z, t, the hoop stretch r / R; with
 // R_0 = 0 its left side is the axis, where the motion must keep u_r = 0.
 //
-// The rectangle's sides are either roller walls (boundary = "walls": the grid's
+// The rectangle's sides are roller walls (boundary = "walls": the grid's
 // walls lie on them, and the motion must keep u . n = 0 and carry no shear
-// traction there) or free (boundary = "free": the motion's traction P N must
-// vanish there). The scene checks the motion against its boundary before
-// anything runs, at 21 points of each side and 8 times up to end_time, and
-// refuses one that breaks it: that motion needs tractions on the boundary,
-// which no boundary condition here applies.
+// traction there), free (boundary = "free": the motion's traction P N must
+// vanish there) or loaded (boundary = "traction": they carry the motion's
+// nominal traction P N, applied by the solver on the sides of the boundary
+// particles' domains, solver/traction.hpp; any motion, plane strain). The
+// scene checks the motion against walls and free sides before anything
+// runs, at 21 points of each side and 8 times up to end_time, and refuses
+// one that breaks them: that motion needs boundary = "traction".
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -25,6 +27,7 @@
 #include <fmt/format.h>
 
 #include "mms/expression_motion.hpp"
+#include "tools/app/scene/exact_traction.hpp"
 #include "tools/app/scene/setup.hpp"
 
 namespace mpmvv::app {
@@ -55,8 +58,10 @@ std::vector<KeySpec> keys() {
       {"height", KeyKind::real, 1.0, "H, its side along Y [m]; a whole number of cells of W / cells", 0.0, inf, true},
       {"boundary", KeyKind::text, std::string("walls"),
        "walls: roller walls on the rectangle's sides (u . n = 0 and no shear traction there); free: traction-free "
-       "sides (P N = 0), the grid two cells and the motion's reach beyond them",
-       -inf, inf, false, false, {"walls", "free"}},
+       "sides (P N = 0), the grid two cells and the motion's reach beyond them; traction: the sides carry the "
+       "motion's nominal traction P N, a force on each boundary particle's domain side (solver/traction.hpp; "
+       "plane strain; the grid as for free)",
+       -inf, inf, false, false, {"walls", "free", "traction"}},
       {"time_scale", KeyKind::real, 0.01,
        "the time over which the motion varies [s] (for the default L / c): the finite-difference check's steps", 0.0,
        inf, true},
@@ -114,7 +119,8 @@ mms::Expression read_formula(const Config& c, const std::string& key, const std:
 // axis (r-z, R_0 = 0) u_r = 0 whatever the boundary; the first point that
 // breaks it makes runs refuse the setup. Returns the largest |u| (the motion's
 // reach).
-double check_boundary(const Config& c, SceneSetup& setup, double R0, double W, double H, bool walls, bool axis) {
+double check_boundary(const Config& c, SceneSetup& setup, double R0, double W, double H, bool walls, bool axis,
+                      bool loaded) {
   const mms::ExactSolution& solution = *setup.solution;
   struct Sample {
     Vec2 X, normal;
@@ -169,6 +175,7 @@ double check_boundary(const Config& c, SceneSetup& setup, double R0, double W, d
       c.reject("displacement_x", fmt::format("the motion is not a number at X = ({:.4g}, {:.4g}), t = {:.4g}", s.X.x(),
                                              s.X.y(), s.t));
     if (setup.run_refused) break;
+    if (loaded) continue;  // the sides carry whatever traction the motion has
     if (moves_axis || (walls && std::abs(s.u_normal) > 1e-8 * body_reach))
       setup.run_refused = {"boundary", fmt::format("the motion crosses {}: at X = ({:.4g}, {:.4g}), t = {:.4g} its u . n "
                                        "= {:.3g} m (largest |u| in the body {:.3g} m); {}",
@@ -176,8 +183,8 @@ double check_boundary(const Config& c, SceneSetup& setup, double R0, double W, d
                                        body_reach, s.on_axis ? "the axis needs u_r = 0" : "walls need u . n = 0")};
     else if (std::abs(s.traction) > 1e-8 * body_stress && !(s.on_axis && !walls))
       setup.run_refused = {"boundary",
-               fmt::format("the motion carries {} at X = ({:.4g}, {:.4g}), t = {:.4g}: {:.3g} Pa (largest stress in the "
-                           "body {:.3g} Pa); {} and no boundary condition here applies a traction",
+               fmt::format("the motion carries {} at X = ({:.4g}, {:.4g}), t = {:.4g}: {:.3g} Pa (the largest change of P over the "
+                           "body and the run {:.3g} Pa); {}: boundary = \"traction\" applies it",
                            walls ? "a shear traction on a roller wall" : "a traction on a free side", s.X.x(), s.X.y(),
                            s.t, s.traction, body_stress,
                            walls ? "walls need (P N) . s = 0" : "free sides need P N = 0")};
@@ -196,9 +203,10 @@ SceneSetup setup(const Config& c) {
   mms::ExpressionMotion motion{read_formula(c, "displacement_x", parameters, rz),
                                read_formula(c, "displacement_y", parameters, rz), std::max(W, H), c.real("time_scale")};
   s.solution = mms::make_solution(motion, s.material, c.real("density"), s.geometry);
-  const bool walls = c.text("boundary") == "walls";
+  const bool walls = c.text("boundary") == "walls", loaded = c.text("boundary") == "traction";
   const bool axis = rz && R0 == 0.0;  // the left side is the axis
-  const double reach = check_boundary(c, s, R0, W, H, walls, axis);
+  if (loaded && rz) c.reject("boundary", "traction is plane strain only (set geometry = \"plane-strain\")");
+  const double reach = check_boundary(c, s, R0, W, H, walls, axis, loaded);
 
   const int cells = int(c.integer("cells"));
   const double h = W / cells;
@@ -217,6 +225,16 @@ SceneSetup setup(const Config& c) {
                                   int(std::ceil(rows - 1e-9)) + 2 * margin);
   }
   s.body_is_rectangle(Vec2(R0, 0.0), Vec2(R0 + W, H));
+  if (loaded) {
+    // The lattice's half spacing: the domains of methods without one (linear).
+    const Vec2 half = Vec2::Constant(0.5 * h / double(c.integer("particles_per_direction")));
+    s.stages = [solution = s.solution, W, H, half](const Particles& P, const GridGeometry&) {
+      SceneStages stages;
+      stages.traction = exact_rectangle_traction(solution, Vec2::Zero(), Vec2(W, H), P, half);
+      return stages;
+    };
+    s.loading = "the motion's nominal traction P N on the rectangle's sides (boundary = \"traction\")";
+  }
 
   const int n = int(c.integer("probe_points"));
   ProbeLine along_x{"line_y_mid", ProbeQuantity::displacement_x, "reference_x", {}, {}, std::nullopt};

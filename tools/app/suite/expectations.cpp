@@ -47,7 +47,7 @@ void read_expectations(const toml::table& top, const std::string& path, const st
     const toml::table& e = *node.as_table();
     const std::string here = where_in(path, node);
     expect_only(e, {"study", "where", "norm", "time", "refine", "levels", "order", "tolerance", "max_error_constant",
-                    "max_error", "must_complete", "interval_within_band"},
+                    "max_error", "at_roundoff", "must_complete", "interval_within_band"},
                 path, "[[expect]]");
     const toml::node* study = e.get("study");
     if (!study || !study->is_string()) throw ConfigError(fmt::format("{}: [[expect]] needs the study it checks", here));
@@ -61,16 +61,24 @@ void read_expectations(const toml::table& top, const std::string& path, const st
     const toml::node* norm = e.get("norm");
     if (!norm || !norm->is_string()) throw ConfigError(fmt::format("{}: [[expect]] needs a norm (an /errors column, e.g. \"L1_theta0\")", here));
     // An order with its band, or a bound on the error itself (exact-solution
-    // scenes whose error sits at round-off or settling level), or both.
+    // scenes whose error sits at round-off or settling level), or both; or
+    // errors at round-off (a patch test: the method reproduces the motion).
     const toml::node* max_error = e.get("max_error");
     if (max_error && !(max_error->value<double>().value_or(-1.0) > 0.0))
       throw ConfigError(fmt::format("{}: [[expect]]: 'max_error' must be a positive number", where_in(path, *max_error)));
-    if (!max_error || e.get("order") || e.get("tolerance")) {
+    for (const char* k : {"must_complete", "interval_within_band", "at_roundoff"})
+      if (const toml::node* m = e.get(k); m && !m->is_boolean())
+        throw ConfigError(fmt::format("{}: [[expect]]: '{}' must be true or false", where_in(path, *m), k));
+    const bool at_roundoff = e.get("at_roundoff") && e.get("at_roundoff")->value<bool>().value_or(false);
+    if (at_roundoff && (e.get("order") || e.get("tolerance")))
+      throw ConfigError(fmt::format("{}: [[expect]]: 'at_roundoff' asks for errors at round-off, where no order can be "
+                                    "observed: give it without 'order' and 'tolerance'", here));
+    if ((!max_error && !at_roundoff) || e.get("order") || e.get("tolerance")) {
       for (const char* k : {"order", "tolerance"}) {
         const toml::node* n = e.get(k);
         if (!n || !(n->is_integer() || n->is_floating_point()))
           throw ConfigError(fmt::format("{}: [[expect]] needs '{}' (a number){}", here, k,
-                                        max_error ? "" : ", or 'max_error' alone"));
+                                        max_error ? "" : ", or 'max_error' or 'at_roundoff = true' alone"));
       }
       if (const toml::node* t = e.get("tolerance"); !(t->value<double>().value_or(-1.0) > 0.0))
         throw ConfigError(fmt::format("{}: [[expect]]: 'tolerance' must be positive", where_in(path, *t)));
@@ -81,9 +89,6 @@ void read_expectations(const toml::table& top, const std::string& path, const st
       throw ConfigError(fmt::format("{}: [[expect]]: 'max_error_constant' must be a positive number", where_in(path, *m)));
     if (const toml::node* t = e.get("time"); t && !(t->value<double>().value_or(-1.0) >= 0.0))
       throw ConfigError(fmt::format("{}: [[expect]]: 'time' must be a time >= 0", where_in(path, *t)));
-    for (const char* k : {"must_complete", "interval_within_band"})
-      if (const toml::node* m = e.get(k); m && !m->is_boolean())
-        throw ConfigError(fmt::format("{}: [[expect]]: '{}' must be true or false", where_in(path, *m), k));
     if (e.get("interval_within_band") && !e.get("order"))
       throw ConfigError(fmt::format("{}: [[expect]]: 'interval_within_band' needs an 'order'", here));
     std::string refine = "cells";
