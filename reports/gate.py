@@ -119,16 +119,15 @@ def check_series(number, expect, series):
         if above:
             reasons.append("error above " + f"{bound:g}: " + ", ".join(f"{series.refine}={l.value}: {l.error:.3g}"
                                                                       for l in above))
-        if not good:
-            left_out = [f"{series.refine}={l.value}: {l.reason}" for l in levels if l.reason]
-            reasons.append("no usable level" + (f" ({'; '.join(left_out)})" if left_out else ""))
+    # A bound on the error itself, or round-off, needs one usable level.
+    if (bound is not None or at_roundoff) and not good:
+        reasons.append("no usable level" + _left_out(series, levels))
     if at_roundoff:
-        reasons.extend(_roundoff_reasons(series, levels, checks, expect["norm"]))
+        reasons.extend(_roundoff_reasons(series, good, checks, expect["norm"]))
     if not has_order:
         pass
     elif len(good) < 2:
-        left_out = [f"{series.refine}={l.value}: {l.reason}" for l in levels if l.reason]
-        reasons.append(f"{len(good)} usable level(s), need 2" + (f" ({'; '.join(left_out)})" if left_out else ""))
+        reasons.append(f"{len(good)} usable level(s), need 2" + _left_out(series, levels))
     elif not math.isfinite(fit.order):
         zero = [l for l in good if not l.error > 0]
         if zero:
@@ -176,12 +175,15 @@ def check_series(number, expect, series):
                    floor)
 
 
-def _roundoff_reasons(series, levels, checks, norm):
-    """Why the usable levels' errors are not all at round-off (at_roundoff), each named."""
-    good = usable(levels)
-    if not good:
-        left_out = [f"{series.refine}={l.value}: {l.reason}" for l in levels if l.reason]
-        return ["no usable level" + (f" ({'; '.join(left_out)})" if left_out else "")]
+def _left_out(series, levels):
+    """ " (cells=32: why; ...)" for the levels left out of a series, "" when none is."""
+    left_out = [f"{series.refine}={l.value}: {l.reason}" for l in levels if l.reason]
+    return f" ({'; '.join(left_out)})" if left_out else ""
+
+
+def _roundoff_reasons(series, good, checks, norm):
+    """Why the usable levels' (`good`, with their `checks`) errors are not all at
+    round-off (at_roundoff), each named."""
     reasons = []
     for level, check in zip(good, checks):
         where = f"{series.refine}={level.value}"

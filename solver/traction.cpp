@@ -35,11 +35,6 @@ void crossings(const GridGeometry& grid, const Vec2& a, const Vec2& b, std::vect
   std::sort(s.begin(), s.end());
 }
 
-bool inside(const GridGeometry& grid, const Vec2& x) {
-  const Vec2 lo = grid.origin, hi = grid.upper();
-  return x.x() >= lo.x() && x.y() >= lo.y() && x.x() <= hi.x() && x.y() <= hi.y();
-}
-
 }  // namespace
 
 void tractions_to_grid(const GridGeometry& grid, const Particles& P, const std::vector<BoundaryEdge>& edges,
@@ -54,7 +49,7 @@ void tractions_to_grid(const GridGeometry& grid, const Particles& P, const std::
       return reference_grid ? A : Vec2(P.position[p] + P.deformation_gradient[p] * (A - P.reference_position[p]));
     };
     const Vec2 a = placed(edge.A), b = placed(edge.B);
-    if (!inside(grid, a) || !inside(grid, b))
+    if (!inside_cells(grid, grid_coordinate(grid, a)) || !inside_cells(grid, grid_coordinate(grid, b)))
       throw std::runtime_error(fmt::format(
           "the boundary side of the particle at X = ({:.6g}, {:.6g}) lies at ({:.6g}, {:.6g}) - ({:.6g}, {:.6g}), "
           "outside the grid [{:.6g}, {:.6g}] x [{:.6g}, {:.6g}]: its traction has no node to act on",

@@ -328,6 +328,11 @@ with tempfile.TemporaryDirectory() as tmp:
                            capture_output=True, text=True, timeout=120)
         check(r.returncode == 2 and key in r.stderr and "no external_command" in r.stderr and not output.exists(),
               f"{key} without external_command: {r.returncode}: {r.stderr}")
+    # VTK's own order, however spelled, is the default and no name of another program's files.
+    r = subprocess.run([MPMVV, "run", str(USER), "--threads", "1", "--quiet", "-o", str(tmp / "vtk-order.h5"),
+                        "--set", SETS[0], "--set", SETS[1], "--set", "external_stress_order=XX,yy,zz,yx,yz,xz"],
+                       capture_output=True, text=True, timeout=120)
+    check(r.returncode == 0, f"VTK's order spelled otherwise, without external_command: {r.returncode}: {r.stderr}")
     r, _ = run(tmp, "bent", "vtk", "vtp", "bent")
     check(r.returncode == 1 and "malformed output" in r.stdout and "the points is not plane strain: z - Z" in r.stdout,
           f"particles moved out of the plane: {r.stdout}")

@@ -30,6 +30,16 @@ namespace {
 
 constexpr const char* kVtkStressOrderText = "xx, yy, zz, xy, yz, xz";
 
+// external_stress_order as parsed (VTK's own order however it is spelled),
+// refused naming the key when malformed.
+StressOrder stress_order_of(const Config& config) {
+  try {
+    return parse_stress_order(config.text("external_stress_order"));
+  } catch (const std::invalid_argument& e) {
+    config.reject("external_stress_order", e.what());
+  }
+}
+
 }  // namespace
 
 std::vector<KeySpec> external_program_keys() {
@@ -71,7 +81,7 @@ std::optional<ExternalProgram> external_program(const Config& config) {
     if (!config.text("external_names").empty())
       config.reject("external_names", "it maps the names of an external program's files, and no external_command "
                                       "names a program (set external_command, or leave external_names out)");
-    if (config.text("external_stress_order") != kVtkStressOrderText)
+    if (stress_order_of(config) != kVtkStressOrder)
       config.reject("external_stress_order", "it orders the stress in an external program's files, and no "
                                              "external_command names a program (set external_command, or leave "
                                              "external_stress_order out)");
@@ -84,11 +94,7 @@ std::optional<ExternalProgram> external_program(const Config& config) {
   } catch (const std::invalid_argument& e) {
     config.reject("external_names", e.what());
   }
-  try {
-    program.stress_order = parse_stress_order(config.text("external_stress_order"));
-  } catch (const std::invalid_argument& e) {
-    config.reject("external_stress_order", e.what());
-  }
+  program.stress_order = stress_order_of(config);
   // Only VTK files hold a 6-component stress; another order would go unused.
   if (program.stress_order != kVtkStressOrder && program.format != "vtk")
     config.reject("external_stress_order", fmt::format("it orders a 6-component stress of VTK files, and "
