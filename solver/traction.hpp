@@ -57,7 +57,8 @@ struct NodeForce {
 
 // Each side's force shared among the nodes at the side's current ends a, b:
 // x_p + F_p (A - X_p) in the updated formulation (the material line the
-// domain's side maps to), A itself in the total one (its grid is the
+// domain's side maps to; computed as the shapes compute the domain's
+// corners, traction.cpp), A itself in the total one (its grid is the
 // reference configuration). Adds to g.force; `applied` holds each share.
 // Throws std::runtime_error naming the side when an end has left the grid.
 void tractions_to_grid(const GridGeometry& grid, const Particles& P, const std::vector<BoundaryEdge>& edges,

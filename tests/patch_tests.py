@@ -1,4 +1,4 @@
-"""The patch-test suite (suites/patch-tests.toml): CPDI reproduces each
+"""The patch-test suite (suites/patch-tests.toml): CPDI and exact CPDI reproduce each
 homogeneous deformation, loaded by its exact traction (boundary = "traction",
 solver/traction.hpp), to round-off, and the gate holds; with a fault in CPDI's
 gradients (MPMVV_FAULT=cpdi-gradient) or the Kirchhoff stress where the
@@ -46,11 +46,11 @@ def suite(out, fault=None, only=None):
 with tempfile.TemporaryDirectory() as tmp:
     tmp = Path(tmp)
     run, gate = suite(tmp / "clean")
-    check(gate.returncode == 0 and "all 2 expectations hold (48 series checked)" in gate.stdout,
+    check(gate.returncode == 0 and "all 4 expectations hold (72 series checked)" in gate.stdout,
           f"the patch tests' gate: exit {gate.returncode}: {gate.stdout[-2000:]}{gate.stderr}")
     # Every gated level below the floor by the numbers it prints (E <= floor).
-    rows = [line for line in gate.stdout.splitlines() if line.startswith(("1 ", "2 "))]
-    check(len(rows) == 48 and all("round-off" in r and "PASS" in r for r in rows), f"the gate's rows: {rows[:3]}")
+    rows = [line for line in gate.stdout.splitlines() if line.startswith(("1 ", "2 ", "3 ", "4 "))]
+    check(len(rows) == 72 and all("round-off" in r and "PASS" in r for r in rows), f"the gate's rows: {rows[:3]}")
 
     def status(name):
         path = tmp / "clean" / "cases" / f"{name}.h5"
@@ -66,9 +66,9 @@ with tempfile.TemporaryDirectory() as tmp:
         s, _ = status(f"other-methods-method={method}-cells=16")
         check(s in ("failed", "lost"), f"{method} on the stretch at 16 cells: {s}")
 
-    for fault, caught in (("cpdi-gradient", 48), ("kirchhoff-stress", 36)):
-        _, gate = suite(tmp / fault, fault, only="^cpdi-")
-        check(gate.returncode == 1 and f"2 of 2 expectations fell short ({caught} of 48 series)" in gate.stdout
+    for fault, caught in (("cpdi-gradient", 72), ("kirchhoff-stress", 54)):
+        _, gate = suite(tmp / fault, fault, only="^cpdi")
+        check(gate.returncode == 1 and f"4 of 4 expectations fell short ({caught} of 72 series)" in gate.stdout
               and "times the round-off floor" in gate.stdout,
               f"MPMVV_FAULT={fault}: exit {gate.returncode}: {gate.stdout[-600:]}")
 

@@ -41,7 +41,7 @@ class ExplicitStages : public Stepper {
         materials_{material, std::move(second_material), stages.second_material_from},
         body_force_(std::move(stages.body_force)),
         traction_(std::move(stages.traction)),
-        grid_(model_.grid, stages, settings.fault == SolverFault::swapped_walls),
+        grid_(model_.grid, model_.particles, stages, settings.fault == SolverFault::swapped_walls),
         bodies_(stages.second_body, model_.grid.node_count(), max_threads()) {
     buffers_.resize(max_threads(), model_.grid.node_count());
     if constexpr (requires { Shape::total_lagrangian; }) tracer_reference_ = model_.tracers;

@@ -72,6 +72,10 @@ struct CpdiExactShapeT : CpdiOutlineT<G, Corners> {
   // Clipping costs as much as the rest of a step: USL evaluates it once
   // (stored_stencils.hpp).
   static constexpr bool stores_stencils = true;
+  // A node reached by a sliver of the domain (a side on a grid line to
+  // round-off) with under 1e-14 of the particle's weight is left empty by
+  // the grid update (grid_conditions.hpp: unresolved_node_mass).
+  static constexpr double unresolved_mass = 1e-14;
 
   static CpdiExactShapeT bind(const GridGeometry& grid, const Particles& particles,
                               const Mat2* deformation_gradient = nullptr, double gradient_scale = 1.0) {
@@ -142,16 +146,49 @@ struct CpdiExactShapeT : CpdiOutlineT<G, Corners> {
         if (m < 3) continue;
         last_ci = std::max(last_ci, ci);
         last_cj = std::max(last_cj, cj);
-        for (int k = 0; k < m; ++k) piece[k] = cell[k] - Vec2(i0 + ci, j0 + cj);
-        const PolygonMoments q = polygon_moments<radial>(piece, m);
         // Nodes (0,0), (1,0), (0,1), (1,1) of the cell in the block.
         const int k00 = cj * block + ci, k10 = k00 + 1, k01 = k00 + block, k11 = k01 + 1;
-        // Integrals of non-negative functions; a sliver's may round to -1e-17.
-        mass[k00] += std::max(0.0, q.area - q.u - q.v + q.uv);
-        mass[k10] += std::max(0.0, q.u - q.uv);
-        mass[k01] += std::max(0.0, q.v - q.uv);
-        mass[k11] += std::max(0.0, q.uv);
-        if constexpr (radial) {
+        if constexpr (!radial) {
+          // The moments about the cell corner nearest the piece (u' = 1 - u
+          // past the cell's middle, v' alike): a sliver along a cell side
+          // then has small coordinates, and the weights and gradients of the
+          // nodes across from it, differences of its moments, keep the
+          // precision of the sliver's own size rather than of the cell's.
+          Vec2 piece_lo, piece_hi;
+          bounds(cell, m, piece_lo, piece_hi);
+          const bool flip_u = piece_lo.x() + piece_hi.x() > 2.0 * (i0 + ci) + 1.0;
+          const bool flip_v = piece_lo.y() + piece_hi.y() > 2.0 * (j0 + cj) + 1.0;
+          for (int k = 0; k < m; ++k)
+            piece[k] = Vec2(flip_u ? i0 + ci + 1 - cell[k].x() : cell[k].x() - (i0 + ci),
+                            flip_v ? j0 + cj + 1 - cell[k].y() : cell[k].y() - (j0 + cj));
+          PolygonMoments q = polygon_moments<false>(piece, m);
+          if (flip_u != flip_v) {  // one reflection turns the vertices clockwise
+            q.area = -q.area, q.u = -q.u, q.v = -q.v, q.uv = -q.uv;
+          }
+          // Node (a', b') of the reflected cell is node (a' xor flip_u, b' xor flip_v),
+          // and d/du = -d/du' where u is reflected.
+          const int n00 = (flip_v ? k01 : k00) + (flip_u ? 1 : 0), n10 = n00 + (flip_u ? -1 : 1),
+                    n01 = n00 + (flip_v ? -block : block), n11 = n01 + (flip_u ? -1 : 1);
+          const double su = flip_u ? -1.0 : 1.0, sv = flip_v ? -1.0 : 1.0;
+          area += q.area;
+          // Integrals of non-negative functions; a sliver's may round to -1e-17.
+          mass[n00] += std::max(0.0, q.area - q.u - q.v + q.uv);
+          mass[n10] += std::max(0.0, q.u - q.uv);
+          mass[n01] += std::max(0.0, q.v - q.uv);
+          mass[n11] += std::max(0.0, q.uv);
+          grad[n00] += Vec2(-su * (q.area - q.v), -sv * (q.area - q.u));
+          grad[n10] += Vec2(su * (q.area - q.v), -sv * q.u);
+          grad[n01] += Vec2(-su * q.v, sv * (q.area - q.u));
+          grad[n11] += Vec2(su * q.v, sv * q.u);
+        } else {
+          // In r-z the moments are about the cell's lower-left corner (non-negative
+          // integrals; a sliver's may round to -1e-17).
+          for (int k = 0; k < m; ++k) piece[k] = cell[k] - Vec2(i0 + ci, j0 + cj);
+          const PolygonMoments q = polygon_moments<radial>(piece, m);
+          mass[k00] += std::max(0.0, q.area - q.u - q.v + q.uv);
+          mass[k10] += std::max(0.0, q.u - q.uv);
+          mass[k01] += std::max(0.0, q.v - q.uv);
+          mass[k11] += std::max(0.0, q.uv);
           // r = h (rho + u) with rho the cell's left edge: int r f = h (rho int f + int u f).
           const double rho = i0 + ci - axis;
           area += rho * q.area + q.u;
@@ -163,12 +200,6 @@ struct CpdiExactShapeT : CpdiOutlineT<G, Corners> {
           grad[k10] += rho * Vec2(q.area - q.v, -q.u) + Vec2(q.u - q.uv, -q.uu);
           grad[k01] += rho * Vec2(-q.v, q.area - q.u) + Vec2(-q.uv, q.u - q.uu);
           grad[k11] += rho * Vec2(q.v, q.u) + Vec2(q.uv, q.uu);
-        } else {
-          area += q.area;
-          grad[k00] += Vec2(-(q.area - q.v), -(q.area - q.u));
-          grad[k10] += Vec2(q.area - q.v, -q.u);
-          grad[k01] += Vec2(-q.v, q.area - q.u);
-          grad[k11] += Vec2(q.v, q.u);
         }
       }
     }

@@ -39,9 +39,9 @@ inline void bilinear_cell(const GridGeometry& grid, const Vec2& x, int* node, do
   gradient[3] = Vec2(fy, fx) * inv_h;
 }
 
-// Bilinear hat weights alone, for callers that form their own gradients.
-inline void bilinear_cell_weights(const GridGeometry& grid, const Vec2& x, int* node, double* weight) {
-  const Vec2 xi = grid_coordinate(grid, x);
+// Bilinear hat weights alone at grid coordinate xi, for callers that form
+// their own gradients.
+inline void bilinear_cell_weights_at(const GridGeometry& grid, const Vec2& xi, int* node, double* weight) {
   const int i = cell_index(xi.x(), grid.cells_x);
   const int j = cell_index(xi.y(), grid.cells_y);
   const double fx = xi.x() - i, fy = xi.y() - j;
@@ -55,6 +55,11 @@ inline void bilinear_cell_weights(const GridGeometry& grid, const Vec2& x, int* 
   weight[1] = fx * gy;
   weight[2] = gx * fy;
   weight[3] = fx * fy;
+}
+
+// The same at a point x of the plane.
+inline void bilinear_cell_weights(const GridGeometry& grid, const Vec2& x, int* node, double* weight) {
+  bilinear_cell_weights_at(grid, grid_coordinate(grid, x), node, weight);
 }
 
 template <Geometry G>
