@@ -110,6 +110,11 @@ TEST(SuiteFile, MistakesNameFileLineAndKey) {
       {study + "sweep = { cells = [32, 64] }\n[[expect]]\nstudy = \"a\"\nnorm = \"L1_theta0\"\nat_roundoff = false\n",
        "[[expect]] needs 'order' (a number), or 'max_error' or 'at_roundoff = true' alone"},
       {study + "set = { inner_radius = 1.3 }\n", "key 'outer_radius': must exceed inner_radius = 1.3 (from"},
+      {study + "set = { cells = 16 }\n", "key 'cells': the ring (outer radius 1.25 m) needs two cells of clearance "
+                                         "inside the 3 m domain, and cells = 16 makes h = 0.1875 m: use cells >= 24, "
+                                         "or a domain over 3.25 m"},
+      {study + "set = { domain = 2.4 }\n", "key 'domain': the ring (outer radius 1.25 m) needs two cells of "
+                                           "clearance inside the 2.4 m domain"},
       {study + "sweep = { cells = [32, 64] }\n[[reference]]\nsource = \"x\"\nstudy = \"a\"\nquantity = \"time_reached\"\n"
                "columns = [\"cells\"]\nrows = [[32, 0.4], [128, 0.3]]\n",
        "s.toml:10: [[reference]]: the row cells=128 matches no case of study 'a'"},

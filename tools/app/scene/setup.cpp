@@ -98,6 +98,24 @@ MaterialModel material_from(const Config& c) {
   return NeoHookean{c.real("lambda"), c.real("mu")};
 }
 
+void require_two_cells_clearance(const Config& config, const std::string& what, double reach, double domain,
+                                 int cells) {
+  const double h = domain / cells;
+  if (reach + 2.0 * h <= 0.5 * domain) return;
+  // reach + 2 domain / n <= domain / 2, so n >= 2 domain / (domain / 2 - reach).
+  const bool fits = 0.5 * domain > reach;
+  const int fewest = fits ? int(std::ceil(2.0 * domain / (0.5 * domain - reach))) : 0;
+  const std::string need = fmt::format("{} needs two cells of clearance inside the {} m domain, and cells = {} makes "
+                                       "h = {:.4g} m", what, domain, cells, h);
+  const std::string wider = fmt::format("a domain over {:.4g} m", 2.0 * (reach + 2.0 * h));
+  // The key the user changed is the one to blame: the domain when it alone was set.
+  const bool domain_set = config.origin("domain").source != "default" && config.origin("cells").source == "default";
+  if (!fits || domain_set)
+    config.reject("domain", fmt::format("{}: use {}{}", need, wider,
+                                        fits ? fmt::format(", or cells >= {}", fewest) : std::string()));
+  config.reject("cells", fmt::format("{}: use cells >= {}, or {}", need, fewest, wider));
+}
+
 std::vector<Vec2> points_on_segment(const Vec2& a, const Vec2& b, int count) {
   std::vector<Vec2> out;
   for (int i = 0; i < count; ++i) out.push_back(a + (b - a) * (double(i) / double(count - 1)));

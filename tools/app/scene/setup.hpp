@@ -160,6 +160,14 @@ std::vector<KeySpec> scene_keys(std::vector<KeySpec> solver, const std::vector<K
 std::vector<KeySpec> material_keys(const std::string& default_material, double lambda, double mu, double density);
 MaterialModel material_from(const Config& config);
 
+// Refuses a square grid of `cells` cells over the square `domain` [m] that
+// leaves less than two cells between a body reaching radius `reach` [m] and
+// the walls (a ring's; `what` names it), with the smallest count of cells
+// and the domain that would fit. Blames the domain where no count of cells
+// can fit or where the domain alone was set, else cells (throws ConfigError).
+void require_two_cells_clearance(const Config& config, const std::string& what, double reach, double domain,
+                                 int cells);
+
 // A line of `count` equally spaced points from a to b.
 std::vector<Vec2> points_on_segment(const Vec2& a, const Vec2& b, int count);
 

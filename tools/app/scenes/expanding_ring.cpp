@@ -71,9 +71,7 @@ SceneSetup setup(const Config& c) {
     const double R = ri + (ro - ri) * i / 100.0;
     reach = std::max(reach, R * (1.0 + motion.amplitude * std::abs(motion.profile(R))));
   }
-  if (reach + 2.0 * s.grid.h > 0.5 * domain)
-    c.reject("domain", fmt::format("the ring reaches r = {:.4g} m and needs two cells of clearance inside the "
-                                   "{} m domain (h = {:.4g} m)", reach, domain, s.grid.h));
+  require_two_cells_clearance(c, fmt::format("the ring, reaching r = {:.4g} m,", reach), reach, domain, cells);
   if (ro - ri < s.grid.h)
     c.reject("cells", fmt::format("the ring is {} m wide but a cell is {:.4g} m: use more cells", ro - ri, s.grid.h));
   s.body_is_annulus(ri, ro);

@@ -65,9 +65,8 @@ SceneSetup setup(const Config& c) {
     c.reject("outer_radius", fmt::format("must exceed inner_radius = {} (from {})", p.inner_radius,
                                          c.origin("inner_radius").source));
   // The motion keeps every radius, so the ring never comes nearer the walls.
-  if (p.outer_radius + 2.0 * s.grid.h > 0.5 * domain)
-    c.reject("domain", fmt::format("the ring (outer radius {}) needs two cells of clearance inside the "
-                                   "{} m domain (h = {:.4g} m)", p.outer_radius, domain, s.grid.h));
+  require_two_cells_clearance(c, fmt::format("the ring (outer radius {} m)", p.outer_radius), p.outer_radius, domain,
+                              cells);
   if (p.outer_radius - p.inner_radius < s.grid.h)
     c.reject("cells", fmt::format("the ring is {} m wide but a cell is {:.4g} m: use more cells",
                                   p.outer_radius - p.inner_radius, s.grid.h));
