@@ -11,9 +11,10 @@ namespace mpmvv {
 // a_g = f_g / m_g (eq. 1.71) and v_g^L = v_g + a_g dt_kick (eq. 1.72). The
 // kick is the step itself, or under central differences the mean of the steps
 // on either side of t_n. Nodes no particle reaches carry no mass and stay at
-// rest, and so do nodes whose mass is at most `unresolved`: the mass below
-// which the shape's weights are round-off (kUnresolvedMass), where f_g / m_g
-// would divide the round-off of a force balance by the round-off of a mass.
+// rest, and so do nodes whose mass is at most `unresolved`, the mass below
+// which the shape's weights are round-off (grid_conditions.hpp:
+// unresolved_node_mass), where f_g / m_g would divide the round-off of a
+// force balance by the round-off of a mass.
 inline void update_grid_motion(GridFields& g, double kick, double unresolved = 0.0) {
   const std::size_t nodes = g.mass.size();
 #pragma omp parallel for schedule(static)
