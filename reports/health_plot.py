@@ -1,7 +1,8 @@
-"""The run-health figure: four panels (five with the measured stable step) over
-time from /probes/monitors, one line per case: the energy balance error over
-its scale, J's range, the largest speed over the wave speed and the largest
-CPDI domain distortion; a failed case's failure time marked x."""
+"""The run-health figure: four panels (more with the holes between the domains,
+what slows the step and the measured stable step) over time from
+/probes/monitors and /probes/coverage, one line per case: the energy balance
+error over its scale, J's range, the largest speed over the wave speed and the
+largest CPDI domain distortion; a failed case's failure time marked x."""
 import math
 from dataclasses import dataclass, field
 
@@ -31,6 +32,11 @@ class HealthCurve:
     # signal speed above the small-strain wave speed; None, or NaN at every time, in older files
     wave_ratio: np.ndarray = None
     basis_stiffening: np.ndarray = None
+    # uncovered_fraction and inside_fraction of /probes/coverage: the share of the material in
+    # holes between the domains, all and away from the body's sides; None, or NaN at every time,
+    # without domains or an exact motion
+    holes: np.ndarray = None
+    holes_inside: np.ndarray = None
 
 
 def _has_finite(values):
@@ -46,6 +52,8 @@ def run_health(curves, title):
     look alike): the energy balance error (log), min J and max J with J = 0 dotted,
     the largest speed over wave speed, the largest domain distortion (log; a note
     instead when every value is NaN, as for linear MPM); one more when any curve
+    has a finite `holes`: the share of the material in holes between the domains
+    in percent, all (solid) and away from the body's sides (dotted); one more when any curve
     has a finite wave_ratio or basis_stiffening: what lifts the CFL step's signal
     speed above the small-strain wave speed, the material's state (solid) and the
     basis (dotted), log; and one more when any curve has a finite step_ratio: the
@@ -54,11 +62,13 @@ def run_health(curves, title):
     height of its last drawn value."""
     with_ratio = any(_has_finite(c.step_ratio) for c in curves)
     with_lift = any(_has_finite(c.wave_ratio) or _has_finite(c.basis_stiffening) for c in curves)
-    rows = 4 + with_lift + with_ratio
+    with_holes = any(_has_finite(c.holes) for c in curves)
+    rows = 4 + with_holes + with_lift + with_ratio
     figure, axes = plt.subplots(rows, 1, figsize=(10.5, 2.75 * rows), sharex=True, squeeze=False,
                                 constrained_layout=True)
     energy, jacobian, speed, distortion = axes[:4, 0]
-    lift = axes[4, 0] if with_lift else None
+    holes = axes[4, 0] if with_holes else None
+    lift = axes[4 + with_holes, 0] if with_lift else None
     ratio = axes[rows - 1, 0] if with_ratio else None
     drawn = {energy: False, distortion: False}
     for k, curve in enumerate(curves):
@@ -78,6 +88,12 @@ def run_health(curves, title):
         # every curve has a line here (NaN values draw nothing): the legend is taken from it
         speed.plot(t, curve.speed_ratio, label=curve.label, **line)
         _mark_stop(speed, curve, t, curve.speed_ratio)
+        if holes is not None:
+            for values, style in ((curve.holes, line["linestyle"]), (curve.holes_inside, ":")):
+                if _has_finite(values):
+                    percent = 100.0 * np.asarray(values, float)
+                    holes.plot(t, percent, **{**line, "linestyle": style})
+                    _mark_stop(holes, curve, t, percent)
         if lift is not None:
             for values, style in ((curve.wave_ratio, line["linestyle"]), (curve.basis_stiffening, ":")):
                 if _has_finite(values):
@@ -100,8 +116,13 @@ def run_health(curves, title):
     figures.label_panel(energy, "", "|energy created| / scale", "energy balance error")
     figures.label_panel(jacobian, "", "J = det F", "min J and max J over the particles")
     figures.label_panel(speed, "", "max |v| / c", "largest particle speed over its wave speed")
-    figures.label_panel(distortion, "" if lift is not None or ratio is not None else "time t [s]",
+    figures.label_panel(distortion, "" if holes is not None or lift is not None or ratio is not None else "time t [s]",
                          "max domain distortion", "largest domain distortion (1: square)")
+    if holes is not None:
+        holes.set_ylim(bottom=0.0)
+        figures.label_panel(holes, "" if lift is not None or ratio is not None else "time t [s]",
+                            "material in holes [%]",
+                            "material in holes between domains: all (solid), away from the sides (dotted)")
     if lift is not None:
         lift.axhline(1.0, color="black", linestyle="-", linewidth=0.6, alpha=0.5)
         lift.set_yscale("log")

@@ -152,11 +152,20 @@ class RunMonitors:
 
 def read_monitors(path):
     """/probes/monitors, or None when absent (results files written before the
-    monitors existed) or without an output time."""
+    monitors existed) or without an output time; with the columns of
+    /probes/coverage (the holes between the domains: uncovered_fraction,
+    inside_fraction, largest_hole_cells ...) beside them where the run has it,
+    at the same output times."""
     with h5py.File(path, "r") as f:
         group = f.get("probes/monitors")
         read = _time_columns(group)
-        return None if read is None else RunMonitors(float(group.attrs.get("initial_energy", float("nan"))), *read)
+        if read is None:
+            return None
+        time, columns = read
+        coverage = _time_columns(f.get("probes/coverage"))
+        if coverage is not None and np.array_equal(coverage[0], time):
+            columns.update({name: values for name, values in coverage[1].items() if name not in columns})
+        return RunMonitors(float(group.attrs.get("initial_energy", float("nan"))), time, columns)
 
 
 def relative_energy_created(monitors):

@@ -7,7 +7,7 @@ What is checked is what the report and the gate read: the root attributes a
 run writes whatever its scene (their types and allowed values, and that
 status, failure and health agree), /particles (one row per particle, the
 shapes of the table), /errors (a `time` column, increasing, and every column
-as long), /probes/monitors likewise, each probe group's `quantity` and the
+as long), /probes/monitors and /probes/coverage likewise, each probe group's `quantity` and the
 shape of its values against its `time` and points. A file an external code's
 run was ingested into is held to the same rules.
 
@@ -131,9 +131,13 @@ def check_probes(f, problems):
     if "external" not in f:
         check_table(f, "probes/monitors", problems, required=("kinetic_energy", "strain_energy", "energy_created",
                                                               "min_J", "max_J"))
+    if "coverage" in f["probes"]:
+        check_table(f, "probes/coverage", problems, required=("uncovered_fraction", "inside_fraction",
+                                                              "largest_hole_area", "largest_hole_cells"))
     for name, group in f["probes"].items():
         # The scene groups without a quantity the format documents.
-        if name in ("monitors", "contact_pressure", "history", "axis_stress") or not isinstance(group, h5py.Group):
+        if name in ("monitors", "coverage", "contact_pressure", "history", "axis_stress") or \
+                not isinstance(group, h5py.Group):
             continue
         where = f"/probes/{name}"
         quantity = _text(group.attrs.get("quantity", ""))

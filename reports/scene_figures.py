@@ -294,7 +294,9 @@ def health_figure(study, all_series, directory):
                                           monitors.column("max_domain_distortion"), style, stop,
                                           monitors.column("cfl_step") / monitors.column("stable_step"),
                                           monitors.column("max_wave_speed_ratio"),
-                                          monitors.column("max_basis_stiffening")))
+                                          monitors.column("max_basis_stiffening"),
+                                          monitors.column("uncovered_fraction"),
+                                          monitors.column("inside_fraction")))
     figure = health_plot.run_health(curves, f"{study}: run health at the output times")
     path = saved(figure, directory, study, 'health')
     caption = (f"{study}: the run's health at each output time (/probes/monitors), one line per case. From the top: "
@@ -303,7 +305,11 @@ def health_figure(study, all_series, directory):
                "has done by then; log scale; absent from results files written before it); "
                "min J and max J over the particles (the lower and upper line of a case's colour), dotted at J = 0; "
                "the largest particle speed over its wave speed; the largest CPDI domain distortion (1: a square "
-               "domain; log scale; none for linear MPM); where the results files have them, what lifts the signal "
+               "domain; log scale; none for linear MPM); where the runs have domains and an exact motion "
+               "(/probes/coverage), the share of the material that no particle domain covers, in percent of the "
+               "body: all of it (solid) and where the domain holding it at the start lay away from the body's "
+               "sides (dotted), the holes that open between domains rather than at a side; where the results "
+               "files have them, what lifts the signal "
                "speed max(max(c_p, k_p c0_p) + |v_p|) that sets the CFL step (cfl h over it) above the small-strain "
                "wave speed c0 at the reference density: the particle's state and density, max c_p / c0 (solid), and the basis, max k_p (dotted; CPDI's corner "
                "interpolation, the total formulation's compressed cell), log scale; where the runs measured it "

@@ -215,6 +215,39 @@ def test_what_slows_the_step_gets_its_panel(tmp_path, drawn):
     assert len(health_plot.run_health(cylinder, "without").axes) == 4
 
 
+def test_holes_between_domains_get_their_panel(tmp_path, drawn):
+    """Requirement: where the results files carry /probes/coverage at the output
+    times of /probes/monitors, each curve carries the share of the material in
+    holes (all, and away from the sides), the figure gets a panel for it and the
+    caption names it; coverage at other times is not read, and files without it
+    draw no such panel."""
+    directory = gold_with_results(tmp_path / "suite", monitors_in=("ring", "rz-cylinder"))
+    for path in (directory / "cases").glob("ring-method=*.h5"):
+        with h5py.File(path, "a") as f:
+            t = f["probes/monitors/time"][:]
+            group = f["probes"].create_group("coverage")
+            group["time"] = t
+            group["uncovered_fraction"] = 0.1 * t
+            group["inside_fraction"] = 0.05 * t
+            group["largest_hole_area"] = 0.0 * t
+            group["largest_hole_cells"] = 0.0 * t
+    for path in (directory / "cases").glob("rz-cylinder-*.h5"):
+        with h5py.File(path, "a") as f:
+            t = f["probes/monitors/time"][:]
+            group = f["probes"].create_group("coverage")
+            group["time"] = t + 1.0                                 # not the monitors' times: left unread
+            group["uncovered_fraction"] = 0.1 * t
+    written, _ = report.write_report(directory, tmp_path / "out")
+    ring = drawn["ring: run health at the output times"]
+    assert ring and all(np.allclose(c.holes, 0.1 * c.time) and np.allclose(c.holes_inside, 0.05 * c.time)
+                        for c in ring)
+    cylinder = drawn["rz-cylinder: run health at the output times"]
+    assert all(np.isnan(c.holes).all() for c in cylinder)
+    assert "the share of the material that no particle domain covers" in written["markdown"].read_text()
+    assert len(health_plot.run_health(ring, "with holes").axes) == 5
+    assert len(health_plot.run_health(cylinder, "without").axes) == 4
+
+
 @needs_gold
 def test_folded_corner_domains_are_named_in_the_caption(tmp_path, drawn):
     """Requirement: a case whose results file counts CPDI corner domains turned over

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "boundary.hpp"
+#include "domain_polygons.hpp"
 #include "model.hpp"
 #include "monitors.hpp"
 #include "stage_times.hpp"
@@ -82,6 +83,10 @@ class Stepper {
   virtual Settling distance_to_equilibrium(double /*shear_modulus*/) const { return {}; }
   // The run's health now (monitors.hpp), and the work done on it so far.
   virtual Monitors monitors() const = 0;
+  // The current domain of every particle (domain_polygons.hpp); empty for a
+  // method without domains, and from a stepper that does not give them (the
+  // implicit one).
+  virtual DomainPolygons domain_polygons() const { return {}; }
   // The largest frequency omega_max [rad/s] of the grid's motion linearized
   // about the current state, by power iteration (explicit steppers; NaN
   // otherwise). Central differences are stable while dt <= 2 / omega_max.

@@ -210,6 +210,10 @@ class ExplicitStepper final : public ExplicitStages<Shape, Material> {
     return m;
   }
 
+  DomainPolygons domain_polygons() const override {
+    return mpmvv::domain_polygons(bind(model_.particles), model_.particles, model_.grid);
+  }
+
   // omega_max of the step's own linearization (largest_frequency.hpp).
   double largest_frequency(int iterations) const override {
     return grid_largest_frequency(

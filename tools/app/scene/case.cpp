@@ -10,6 +10,7 @@
 
 #include <fmt/format.h>
 
+#include "coverage.hpp"
 #include "external_case.hpp"
 #include "monitor_log.hpp"
 #include "norms.hpp"
@@ -126,6 +127,7 @@ class Case final : public SceneCase, private RunObserver {
   void persist(StateArchive& a) {
     probes_.persist(a);
     monitor_log_.persist(a);
+    coverage_.persist(a);
     a.field("rule_step", rule_step_);
     a.field("errors", errors_);
     a.field("integrated", integrated_);
@@ -194,6 +196,7 @@ class Case final : public SceneCase, private RunObserver {
     write_probes(probes, probes_);
     if (setup_.write_extra) setup_.write_extra(probes);
     write_monitors(probes, monitor_log_, config_.integer("stable_step_iterations") > 0);
+    if (coverage_.on()) write_coverage(probes, coverage_, setup_.grid.h);
     if (settling_ && stepper_)
       write_settling(root, *settling_, settling_->measure(outcome_.time_reached, *stepper_), outcome_.time_reached,
                      errors_);
@@ -223,6 +226,13 @@ class Case final : public SceneCase, private RunObserver {
       integrated_.add(0.0, d.l2, d.exact2);
     }
     monitor_log_.start(s);
+    // The lattice of the coverage monitor, over the domains as seeded.
+    const std::int64_t samples = config_.integer("coverage_samples");
+    const double particle_spacing = setup_.grid.h / double(config_.integer("particles_per_direction"));
+    if (setup_.exact_motion && samples > 0)
+      coverage_.start(s.domain_polygons(), particle_spacing / double(samples), particle_spacing);
+    else
+      coverage_ = {};
     settling_.reset();
     if (setup_.settling) {
       settling_.emplace(*setup_.settling, loop_.end_time, !implicit());
@@ -246,6 +256,7 @@ class Case final : public SceneCase, private RunObserver {
     monitor_log_.record(t, s, int(config_.integer("stable_step_iterations")), rule_step_,
                         config_.real("energy_blowup_factor"));
     errors_.time.push_back(t);
+    if (coverage_.on()) coverage_.record(t, s.domain_polygons(), s.model().particles, *setup_.solution);
     if (config_.text("particle_fields") == "outputs")
       snapshots_.record(t, s.model().particles, setup_.exact_motion ? setup_.solution.get() : nullptr,
                         s.model().tracers);
@@ -283,6 +294,7 @@ class Case final : public SceneCase, private RunObserver {
   ProbeRecorder probes_;
   ParticleSnapshots snapshots_;  // with particle_fields = "outputs"
   MonitorLog monitor_log_;
+  DomainCoverage coverage_;  // with domains and an exact motion (coverage_samples > 0)
   double rule_step_ = std::numeric_limits<double>::quiet_NaN();  // the time-step rule's last step
   ErrorTable errors_;
   TimeIntegral integrated_;

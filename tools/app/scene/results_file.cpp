@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "coverage.hpp"
 #include "monitor_log.hpp"
 #include "probes.hpp"
 #include "solver/parallel.hpp"
@@ -15,6 +16,15 @@
 namespace mpmvv::app {
 
 namespace {
+
+// One value of each row, a dataset as long as the rows.
+template <class Row, class Get>
+void write_column(h5::Group& g, const std::vector<Row>& rows, const char* name, Get get) {
+  std::vector<double> v;
+  v.reserve(rows.size());
+  for (const Row& r : rows) v.push_back(get(r));
+  g.write(name, v, {rows.size()});
+}
 
 using MonitorRow = MonitorLog::Row;
 
@@ -243,12 +253,7 @@ void write_monitors(h5::Group& probes, const MonitorLog& log, bool stable_step) 
                   "grid's edge, CPDI corner domains turned over, and what lifts the signal speed of the CFL step above the small-strain wave speed: "
                   "the particle's state and density (max c_p / c0, c0 at the reference density) and the basis (max k_p) [J per unit depth; per radian in r-z]");
   g.set_attribute("initial_energy", log.initial_energy());
-  const std::size_t n = log.rows().size();
-  auto column = [&](const char* name, auto get) {
-    std::vector<double> v;
-    for (const MonitorRow& r : log.rows()) v.push_back(get(r));
-    g.write(name, v, {n});
-  };
+  auto column = [&](const char* name, auto get) { write_column(g, log.rows(), name, get); };
   column("time", [](const MonitorRow& r) { return r.time; });
   column("kinetic_energy", [](const MonitorRow& r) { return r.monitors.kinetic; });
   column("strain_energy", [](const MonitorRow& r) { return r.monitors.strain; });
@@ -275,6 +280,31 @@ void write_monitors(h5::Group& probes, const MonitorLog& log, bool stable_step) 
     column("stable_step", [](const MonitorRow& r) { return 2.0 / r.largest_frequency; });
     column("cfl_step", [](const MonitorRow& r) { return r.cfl_step; });
   }
+}
+
+void write_coverage(h5::Group& probes, const DomainCoverage& coverage, double cell_size) {
+  h5::Group g = probes.create_group("coverage");
+  g.set_attribute("description",
+                  "how the particles' domains cover the body (tools/app/scene/coverage.hpp): a lattice of "
+                  "reference points inside the domains as seeded, carried to each output time by the exact motion "
+                  "shifted by the particles' displacement errors interpolated over the reference body, and looked "
+                  "up among the current domains; a point no domain contains lies in a hole. "
+                  "uncovered_fraction: the share of the sampled material in holes (by reference area); "
+                  "inside_fraction: the same for the points whose domain at the start lay away from the body's "
+                  "sides (at a side a domain's edge and its centre also part by the error in F); "
+                  "largest_hole_area: the current area of the largest 4-connected set of such points on the "
+                  "lattice [m^2 per unit depth; of the r-z plane in r-z], resolved to the lattice spacing; "
+                  "largest_hole_cells: the same in cells h^2");
+  g.set_attribute("lattice_spacing", coverage.spacing());
+  g.set_attribute("sampled_points", double(coverage.sampled_points()));
+  g.set_attribute("cell_size", cell_size);
+  auto column = [&](const char* name, auto get) { write_column(g, coverage.rows(), name, get); };
+  column("time", [](const DomainCoverage::Row& r) { return r.time; });
+  column("uncovered_fraction", [](const DomainCoverage::Row& r) { return r.uncovered_fraction; });
+  column("inside_fraction", [](const DomainCoverage::Row& r) { return r.inside_fraction; });
+  column("largest_hole_area", [](const DomainCoverage::Row& r) { return r.largest_hole_area; });
+  column("largest_hole_cells",
+         [&](const DomainCoverage::Row& r) { return r.largest_hole_area / (cell_size * cell_size); });
 }
 
 void write_settling(h5::Group& root, const SettlingWatch& watch, const Settling& s, double end,

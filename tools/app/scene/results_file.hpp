@@ -20,6 +20,7 @@ namespace mpmvv::app {
 
 class ProbeRecorder;
 class MonitorLog;
+class DomainCoverage;
 
 // How the run was asked for, as the root's attributes record it.
 struct RunIdentity {
@@ -47,6 +48,9 @@ void write_particle_index(h5::Group& root, std::size_t count);
 void write_errors(h5::Group& root, const ErrorTable& errors, const std::string& description);
 void write_probes(h5::Group& probes, const ProbeRecorder& recorder);
 void write_monitors(h5::Group& probes, const MonitorLog& log, bool stable_step);
+// /probes/coverage: the holes between the particles' domains at each output
+// time (coverage.hpp), with the cell size h they are counted in.
+void write_coverage(h5::Group& probes, const DomainCoverage& coverage, double cell_size);
 // A static scene's distance from its static state at the end time `end`
 // (settling.hpp), `at_end` measured there.
 void write_settling(h5::Group& root, const SettlingWatch& watch, const Settling& at_end, double end,

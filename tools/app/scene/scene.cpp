@@ -100,6 +100,14 @@ std::vector<KeySpec> solver_keys(std::int64_t default_cells, double default_end_
        "(monitors largest_frequency, stable_step, cfl_step; explicit steps only; 0: not measured, 30 is plenty; each "
        "iteration costs about two transfers)",
        0, 10000},
+      {"coverage_samples", KeyKind::integer, std::int64_t(0),
+       "lattice points per particle spacing along each axis with which the body is sampled to find the holes "
+       "between the particles' domains, where no domain covers the material (tools/app/scene/coverage.hpp; "
+       "/probes/coverage: the share of the material in holes and the largest hole's area, at every output time; "
+       "methods with domains, updated formulation, scenes with an exact motion; 0: not measured; 2 is plenty, "
+       "and costs about 0.8 us a particle at each output time, 16 bytes a particle held, about 120 more while "
+       "it measures)",
+       0, 16},
       // Defaults from the ring runs on record (cpdi, cpdi-exact, uGIMP, B-splines;
       // 30-1200 cells, soft and stiff): runs that converge reach J / J_exact
       // 0.116-3.35, error over motion 0.15 and energy lost 0.44 at most; runs
