@@ -27,10 +27,15 @@ def slug(*parts):
     return re.sub(r"[^A-Za-z0-9_.=-]+", "_", "-".join(str(p) for p in parts)).strip("_")
 
 
+# Figures written by saved() in this process (the report's progress counts them).
+written = {"figures": 0}
+
+
 def saved(figure, directory, study, *name):
     """The figure written to DIRECTORY/<study-name>.png (figures.save_png): its path."""
     path = directory / f"{slug(study, *name)}.png"
     figures.save_png(figure, path)
+    written["figures"] += 1
     return path
 
 

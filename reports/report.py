@@ -27,6 +27,7 @@ from dataclasses import dataclass
 from datetime import datetime
 from pathlib import Path
 
+from . import figure_parts
 from . import gate
 from . import orders
 from .report_figures import external_comparison_figure, study_figures
@@ -77,11 +78,13 @@ DEFINITIONS = (
     "case wrote the norm at that time (a failed run keeps the outputs it reached).")
 
 
-def build_report(suite, figure_directory):
+def build_report(suite, figure_directory, progress=None):
+    """The report of `suite`, its figures written to `figure_directory`;
+    `progress(done, total, study)` is told before each study's figures and once
+    more at the end (done == total, study None)."""
     rows, grid_rows = order_rows(suite), gci_rows(suite)
-    sections = [("Cases", "Status from manifest.json; time reached, failure reason, health verdict (for a run by "
-                 "another program, the rules its output let mpmvv judge), wall time of the time loop, steps and "
-                 "particle count from each results file.", case_table(suite))]
+    # The gate's verdict first: what a reader asks before anything else.
+    sections = []
     verdicts, gate_error = None, ""
     if suite.expectations:
         try:
@@ -91,6 +94,9 @@ def build_report(suite, figure_directory):
         except SuiteDirectoryError as error:
             gate_error = str(error)
             sections.append(("Expectations", f"Not checked: {error}", None))
+    sections.append(("Cases", "Status from manifest.json; time reached, failure reason, health verdict (for a run by "
+                     "another program, the rules its output let mpmvv judge), wall time of the time loop, steps and "
+                     "particle count from each results file.", case_table(suite)))
     sections += reference_sections(suite, rows)
     sections += measurement_sections(suite)
     fitted = [r for r in rows if len(r.levels) >= 2]
@@ -107,12 +113,39 @@ def build_report(suite, figure_directory):
                      "value is shown only to check the band f_fine (1 +- GCI). Convergence round-off: a change between "
                      f"two levels is at most ({orders.ROUNDOFF_ULPS} + steps) ulps of the point's |X| (pi for an "
                      "angle), which rounding alone can explain: no order, extrapolation or GCI.", gci_table(grid_rows)))
-    entries = [e for study in suite.study_names() for e in study_figures(suite, study, rows, figure_directory)]
+    entries, studies = [], suite.study_names()
+    for done, study in enumerate(studies):
+        if progress:
+            progress(done, len(studies), study)
+        entries += study_figures(suite, study, rows, figure_directory)
     comparison = external_comparison_figure(suite, figure_directory)
+    if progress:
+        progress(len(studies), len(studies), None)
     if comparison is not None:
         entries.insert(0, comparison)
     return Report(suite, datetime.now(), status_counts(suite), stored_norm_check(suite), rows, grid_rows,
                   sections, entries, verdicts, gate_error)
+
+
+def verdict_lines(report):
+    """The gate's verdict in a line (PASS, FAIL, not checked, or no expectations),
+    then one line for each series that fell short: what the report opens with."""
+    suite = report.suite
+    if not suite.expectations:
+        return "none", ["Verdict: none. This suite has no [[expect]], so it gates nothing; its cases and "
+                        "figures follow."]
+    if report.verdicts is None:
+        return "fail", [f"Verdict: not checked: {report.gate_error}"]
+    summary = gate.summary_line(report.verdicts, len(suite.expectations))
+    short = [v for v in report.verdicts if not v.passed]
+    if not short:
+        return "pass", [f"Verdict: PASS. {summary[0].upper() + summary[1:]}."]
+    lines = [f"Verdict: FAIL. {summary[0].upper() + summary[1:]}:"]
+    for v in short:
+        row = dict(zip(gate.HEADER, gate.verdict_row(v)))
+        lines.append(f"expectation {row['#']} ({row['study']}, {row['series']}, {row['norm']} at t = {row['t']}): "
+                     f"observed {row['observed order [95% CI]']}, expected {row['expected']}: {row['reason']}")
+    return "fail", lines
 
 
 def header_lines(report):
@@ -134,6 +167,9 @@ body { font-family: sans-serif; margin: 1.5em auto; max-width: 1400px; color: #2
 table { border-collapse: collapse; font-size: 0.85em; margin: 0.5em 0 1.5em; }
 th, td { border: 1px solid #ccc; padding: 2px 6px; text-align: left; vertical-align: top; }
 th { background: #f0f0f0; position: sticky; top: 0; }
+div.verdict { border-left: 6px solid #888; background: #f6f6f6; padding: 0.3em 1em; margin: 0.5em 0 1em; }
+div.verdict.pass { border-color: #1a7f37; background: #eef8f0; }
+div.verdict.fail { border-color: #c62828; background: #fdeeee; }
 tr.completed td:nth-child(2), tr.PASS td:nth-child(10), tr.asymptotic td:last-child { color: #1a7f37; }
 tr.failed td:nth-child(2), tr.lost td:nth-child(2), tr.crashed td:nth-child(2), tr.timeout td:nth-child(2), tr.error td:nth-child(2),
 tr.FAIL td:nth-child(10), tr.stalled td:last-child { color: #c62828; font-weight: bold; }
@@ -159,6 +195,10 @@ def render_html(report):
     suite = report.suite
     parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(suite.name)}</title>"
              f"<style>{CSS}</style></head><body><h1>Convergence report: {html.escape(suite.name)}</h1>"]
+    kind, verdict = verdict_lines(report)
+    parts.append(f"<div class='verdict {kind}'><p><strong>{html.escape(verdict[0])}</strong></p>" +
+                 ("<ul>" + "".join(f"<li>{html.escape(line)}</li>" for line in verdict[1:]) + "</ul>"
+                  if len(verdict) > 1 else "") + "</div>")
     parts += [f"<p>{html.escape(line)}</p>" for line in header_lines(report)]
     for title, text, table in report.sections:
         parts.append(f"<h2>{html.escape(title)}</h2><p>{html.escape(text)}</p>")
@@ -186,6 +226,8 @@ def markdown_table(table):
 
 def render_markdown(report, output_directory):
     lines = [f"# Convergence report: {report.suite.name}", ""]
+    _, verdict = verdict_lines(report)
+    lines += [f"**{verdict[0]}**", ""] + [f"- {line}" for line in verdict[1:]] + ([""] if len(verdict) > 1 else [])
     lines += [line + "\n" for line in header_lines(report)]
     for title, text, table in report.sections:
         lines += [f"## {title}", "", text, "", markdown_table(table) if table and table.rows else "_none_", ""]
@@ -201,15 +243,16 @@ def render_markdown(report, output_directory):
     return "\n".join(lines)
 
 
-def write_report(directory, output=None):
-    """Read the suite, write every output; returns the paths written."""
+def write_report(directory, output=None, progress=None):
+    """Read the suite, write every output; returns the paths written
+    (`progress` as for build_report)."""
     suite = read_suite(directory)
     output = Path(output) if output else suite.directory / "report"
     figure_directory = output / "figures"
     figure_directory.mkdir(parents=True, exist_ok=True)
     for old in figure_directory.glob("*.png"):
         old.unlink()
-    report = build_report(suite, figure_directory)
+    report = build_report(suite, figure_directory, progress)
     written = {"html": output / "report.html", "markdown": output / "report.md",
                "orders": output / "orders.csv", "levels": output / "levels.csv", "gci": output / "gci.csv",
                "summary": output / "summary.json"}
@@ -232,10 +275,18 @@ def main(argv):
                             "directory, from its results files only.")
     parser.add_argument("directory", metavar="DIR", help="a suite output directory (mpmvv suite SUITE -o DIR)")
     parser.add_argument("-o", "--output", metavar="OUT", help="where to write (default DIR/report)")
+    parser.add_argument("-q", "--quiet", action="store_true", help="no progress lines on stderr")
     args = parser.parse_args(argv)
-    start = clock.perf_counter()
+    start, figures_before = clock.perf_counter(), figure_parts.written["figures"]
+
+    def progress(done, total, study):
+        """One line on stderr per study: how many studies are done, the figures so far, the time."""
+        now = f"{figure_parts.written['figures'] - figures_before} figures, {clock.perf_counter() - start:.0f} s"
+        step = f"study {done + 1} of {total}: {study}" if study is not None else f"{total} of {total} studies"
+        print(f"mpmvv report: {step} ({now})", file=sys.stderr, flush=True)
+
     try:
-        written, figure_count = write_report(args.directory, args.output)
+        written, figure_count = write_report(args.directory, args.output, None if args.quiet else progress)
     except SuiteDirectoryError as error:
         print(f"mpmvv report: {error}", file=sys.stderr)
         return 2

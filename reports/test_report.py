@@ -155,7 +155,7 @@ def test_suite_without_contact_history_or_measurements_renders_as_before(synthet
     output, written, figure_count = synthetic_report
     assert sorted(p.name for p in (output / "figures").glob("*.png")) == RING_FIGURES
     markdown = written["markdown"].read_text()
-    assert re.findall(r"^## .*", markdown, re.M) == ["## Cases", "## Expectations", "## Observed orders",
+    assert re.findall(r"^## .*", markdown, re.M) == ["## Expectations", "## Cases", "## Observed orders",
                                                      "## Richardson extrapolation and grid convergence index",
                                                      "## Figures"]
     assert "Measurements" not in written["html"].read_text()
@@ -389,3 +389,41 @@ def test_grid_convergence_of_changes_at_round_off_has_no_order(tmp_path):
     assert report_rows.point_changes_at_roundoff(cases, point, (1e-6, 1e-6 + 0.5 * floor, 1e-6 + 0.75 * floor))
     assert not report_rows.point_changes_at_roundoff(cases, point, (1e-6, 1e-6 + 4 * floor, 1e-6 + 6 * floor))
 
+
+
+def test_report_tells_its_progress_by_study_unless_quiet(tmp_path, capsys):
+    """Requirement: mpmvv report says on stderr how far it is, a line before
+    each study's figures (study k of n, the figures written so far, the time)
+    and one at the end; --quiet says nothing there."""
+    directory = write_suite_directory(tmp_path / "suite", SYNTHETIC_SUITE, synthetic_ring_cases())
+    assert report.main([str(directory), "-o", str(tmp_path / "out")]) == 0
+    lines = capsys.readouterr().err.splitlines()
+    studies = len(report.read_suite(directory).study_names())
+    assert lines[0].startswith(f"mpmvv report: study 1 of {studies}: ") and "(0 figures, " in lines[0]
+    assert re.match(rf"mpmvv report: {studies} of {studies} studies \(([1-9][0-9]*) figures, [0-9]+ s\)$", lines[-1])
+    assert len(lines) == studies + 1
+    assert report.main([str(directory), "-o", str(tmp_path / "out"), "--quiet"]) == 0
+    assert capsys.readouterr().err == ""
+
+
+def test_the_report_opens_with_the_gates_verdict(synthetic_report, tmp_path):
+    """Requirement: the first thing the report says, under its title, is the
+    gate's verdict (PASS, FAIL, or that the suite gates nothing), and for a FAIL
+    each series that fell short with its observed and expected order and why;
+    the expectations' table is the first section."""
+    output, written, _ = synthetic_report
+    markdown = written["markdown"].read_text().splitlines()
+    assert markdown[2] == "**Verdict: PASS. All 1 expectations hold (1 series checked).**"
+    assert "<div class='verdict pass'><p><strong>Verdict: PASS." in written["html"].read_text()
+    unreachable = SYNTHETIC_SUITE.replace("order = 2.0", "order = 3.0")
+    directory = write_suite_directory(tmp_path / "short", unreachable, synthetic_ring_cases())
+    written, _ = render(directory, tmp_path / "short-report")
+    markdown = written["markdown"].read_text().splitlines()
+    assert markdown[2] == "**Verdict: FAIL. 1 of 1 expectations fell short (1 of 1 series):**"
+    assert markdown[4].startswith("- expectation 1 (ring, method=cpdi, L1_theta0 at t = ")
+    assert "observed 2.000" in markdown[4] and "expected [2.9, 3.1]" in markdown[4]
+    assert "<div class='verdict fail'>" in written["html"].read_text()
+    ungated = SYNTHETIC_SUITE[:SYNTHETIC_SUITE.index("[[expect]]")]
+    directory = write_suite_directory(tmp_path / "ungated", ungated, synthetic_ring_cases())
+    written, _ = render(directory, tmp_path / "ungated-report")
+    assert written["markdown"].read_text().splitlines()[2].startswith("**Verdict: none. This suite has no [[expect]]")

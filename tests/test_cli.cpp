@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "solver/io/hdf5.hpp"
 #include "tools/app/scene/setup.hpp"
 
 namespace {
@@ -261,3 +262,20 @@ TEST_F(Cli, MmsEvalRzReportsHoopStretchAndRefusesTheAxis) {
 }
 
 }  // namespace
+
+// A run that names no OpenMP wait policy is run with "passive" (spinning
+// threads take the cores from whatever else runs: tools/cli/main.cpp), and
+// one that names a policy keeps it; the results file says which.
+TEST_F(Cli, ThreadsWaitPassivelyUnlessTheRunNamesAPolicy) {
+  for (const auto& [environment, expected] : {std::pair<std::string, std::string>{"env -u OMP_WAIT_POLICY ", "passive"},
+                                              {"env OMP_WAIT_POLICY=active ", "active"}}) {
+    const fs::path file = directory_ / "policy.h5";
+    const std::string command = environment + quoted(MPMVV_BINARY) + " run " + ring_scene() +
+                                " -q -t 2 --set cells=24 --set end_time=0.01 -o " + quoted(file.string()) +
+                                " >/dev/null 2>&1 </dev/null";
+    const int raw = std::system(command.c_str());
+    ASSERT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 0) << command;
+    const mpmvv::h5::File f = mpmvv::h5::File::open_read(file.string());
+    EXPECT_EQ(f.root().attribute_string("omp_wait_policy"), expected) << environment;
+  }
+}

@@ -1,6 +1,7 @@
 #include "results_file.hpp"
 
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <limits>
 #include <numeric>
@@ -77,6 +78,8 @@ void write_run(h5::Group root, const RunIdentity& request, const Config& config,
   root.set_attribute("version", request.version);
   if (fault != Fault::none) root.set_attribute("fault_injected", to_string(fault));
   root.set_attribute("threads", std::int64_t(max_threads()));
+  const char* wait_policy = std::getenv("OMP_WAIT_POLICY");  // as libgomp read it at load (tools/cli/main.cpp)
+  root.set_attribute("omp_wait_policy", std::string(wait_policy ? wait_policy : ""));
   root.set_attribute("status", run_status(o, health));
   const bool lost_at_end = o.completed && health.lost;
   root.set_attribute("failure_reason", lost_at_end ? std::string("solution lost") : o.failure_reason);

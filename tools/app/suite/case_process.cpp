@@ -54,10 +54,12 @@ pid_t spawn_case(const std::string& exe, const SuiteCase& c, const fs::path& res
   std::vector<std::string> env_strings;
   for (char** e = environ; *e; ++e) {
     const std::string entry(*e);
-    if (entry.rfind("OMP_WAIT_POLICY=", 0) != 0 && entry.rfind(std::string(kSuiteParent) + "=", 0) != 0)
+    if (!(passive_wait && entry.rfind("OMP_WAIT_POLICY=", 0) == 0) && entry.rfind(std::string(kSuiteParent) + "=", 0) != 0)
       env_strings.push_back(entry);
   }
-  // Cases share the cores: waiting threads must not spin on them.
+  // Cases share the cores: waiting threads must not spin on them. A case
+  // alone keeps the suite's own policy (passive unless the user named one:
+  // tools/cli/main.cpp).
   if (passive_wait) env_strings.emplace_back("OMP_WAIT_POLICY=passive");
   // The case ends with the suite, however the suite ends (run_case.cpp).
   env_strings.push_back(fmt::format("{}={}", kSuiteParent, ::getpid()));
