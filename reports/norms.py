@@ -42,6 +42,8 @@ DEFORMATION_NORMS = ("particle_deformation_L2",)
 # In m/s:
 #     particle_velocity_L2 = sqrt(sum_p V_p0 |v_p - v_exact(X_p, t)|^2 / sum_p V_p0)
 VELOCITY_NORMS = ("particle_velocity_L2",)
+# In Pa: the RMS error of the in-plane mean stress -(sigma_xx + sigma_yy) / 2.
+PRESSURE_NORMS = ("particle_pressure_L2",)
 
 QUANTITY_UNITS = {
     "angular_displacement": "rad",
@@ -93,13 +95,18 @@ def stored_l1_discrepancy(stored, recomputed):
 
 
 def norm_unit(norm, line_quantities):
-    """Unit of an /errors column: m for particle norms, the line's quantity unit for L1_<line>."""
+    """Unit of an /errors column: m for particle displacement norms, Pa for the
+    pressure, m/s for the velocity, 1 for F and for relative errors (the
+    time-integrated relative norm and a scene's error_* columns, results-format.md),
+    the line's quantity unit for L1_<line>."""
     if norm in PARTICLE_NORMS:
         return "m"
-    if norm in RELATIVE_NORMS or norm in DEFORMATION_NORMS:
+    if norm in RELATIVE_NORMS or norm in DEFORMATION_NORMS or norm.startswith("error_"):
         return "1"
     if norm in VELOCITY_NORMS:
         return "m/s"
+    if norm in PRESSURE_NORMS:
+        return "Pa"
     quantity = line_quantities.get(norm[len("L1_"):]) if norm.startswith("L1_") else None
     return QUANTITY_UNITS.get(quantity, "")
 
@@ -118,6 +125,10 @@ def describe_norm(norm, line_quantities):
         return "volume-weighted RMS error of each particle's deformation gradient F (Frobenius)"
     if norm == "particle_velocity_L2":
         return "volume-weighted RMS particle velocity error"
+    if norm == "particle_pressure_L2":
+        return "volume-weighted RMS error of the particle pressure (in-plane mean stress)"
+    if norm.startswith("error_"):
+        return f"relative error of the scene's {norm[len('error_'):].replace('_', ' ')}, |measured / exact - 1|"
     if norm == "particle_relative_L2_integrated":
         return "time-integrated relative L2 particle displacement error, from t = 0"
     if norm.startswith("L1_"):

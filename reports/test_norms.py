@@ -53,4 +53,8 @@ def test_units_and_descriptions_follow_the_line_quantity():
     assert norms.norm_unit("particle_L2", quantities) == "m"
     assert norms.norm_unit("particle_velocity_L2", quantities) == "m/s"
     assert norms.norm_unit("particle_deformation_L2", quantities) == "1"
+    assert norms.norm_unit("particle_pressure_L2", quantities) == "Pa"
+    assert norms.norm_unit("error_axial_stress", quantities) == "1"
+    assert "relative error" in norms.describe_norm("error_axial_stress", quantities)
+    assert "pressure" in norms.describe_norm("particle_pressure_L2", quantities)
     assert "eq. 3.1" in norms.describe_norm("L1_theta0", quantities)

@@ -54,7 +54,25 @@ class StaticStepper final : public Stepper {
     force_scale_ = 2.0 * m.mu * model_.grid.h;
   }
 
+  // The load step [t, t + dt], halved where its solve fails
+  // (StaticOptions::max_halvings); failure_ says why the last try failed.
   void step(double t, double dt, double) override {
+    failure_.clear();
+    if (step_in_halves(t, dt, 0)) failure_.clear();
+  }
+
+  bool step_in_halves(double t, double dt, int depth) {
+    if (solve_load_step(t, dt)) return true;
+    if (depth >= options_.max_halvings) {
+      if (depth > 0) failure_ += fmt::format(" (a load step of {:.3g} s, halved {} times)", dt, depth);
+      return false;
+    }
+    ++halvings_;
+    return step_in_halves(t, 0.5 * dt, depth + 1) && step_in_halves(t + 0.5 * dt, 0.5 * dt, depth + 1);
+  }
+
+  // One solve from t to t + dt; the particles move only when it converges.
+  bool solve_load_step(double t, double dt) {
     time_ = t;
     failure_.clear();
     Particles& P = model_.particles;
@@ -90,9 +108,11 @@ class StaticStepper final : public Stepper {
     if (!result.converged) {
       failure_ = fmt::format("KINSOL: {} after {} Newton iterations (|R| / (2 mu h) = {:.3g})",
                              result.message, result.iterations, result.residual_norm);
-      return;
+      return false;
     }
+    if (!failure_.empty()) return false;  // the contact's active set kept changing
     finish(shape, q, dt);
+    return true;
   }
 
   std::string step_failure() const override { return failure_; }
@@ -112,6 +132,7 @@ class StaticStepper final : public Stepper {
             {"newton_iterations", double(newton_iterations_)},
             {"gmres_iterations", double(linear_iterations_)},
             {"residual_evaluations", double(residual_evaluations_)},
+            {"load_step_halvings", double(halvings_)},
             {"preconditioner_seconds", tangent_.seconds()}};
   }
 
@@ -280,6 +301,7 @@ class StaticStepper final : public Stepper {
   std::vector<Vec2> u_;  // the node displacements of the last residual's unknowns
   SmallStrainTangent tangent_;
   std::string failure_;
+  long halvings_ = 0;  // load steps taken again as two halves (step_in_halves)
   long newton_iterations_ = 0, linear_iterations_ = 0, residual_evaluations_ = 0, solves_ = 0;
   Remaining remaining_;
 };

@@ -35,6 +35,12 @@ struct StaticOptions {
   double tolerance = 1e-8;
   long max_iterations = 50;  // Newton iterations per solve
   int max_contact_passes = 30;
+  // A load step whose solve fails (KINSOL cannot evaluate the residual at
+  // the start, a line search that keeps meeting non-finite residuals, no
+  // convergence) is taken again as two halves, each halved again the same
+  // way, at most this many times: the start of a shorter step is nearer to
+  // its equilibrium. 0: a failed step stops the run.
+  int max_halvings = 6;
 };
 
 // Plane strain; every shape-function family; every material.
