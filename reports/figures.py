@@ -100,6 +100,7 @@ def _finite_positive(x, y):
 def error_against_h(curves, title, y_label, x_label="cell size h [m]"):
     figure, axes = plt.subplots(figsize=(10.5, 5.0), constrained_layout=True)
     all_h, all_e = [], []
+    fitted = with_interval = False
     for curve in curves:
         h, e = _finite_positive(curve.x, curve.y)
         if not h:
@@ -108,8 +109,10 @@ def error_against_h(curves, title, y_label, x_label="cell size h [m]"):
         all_e += e
         label = curve.label
         if curve.fit is not None and math.isfinite(curve.fit.order):
+            fitted = True
             label += f": p = {curve.fit.order:.2f}"
             if math.isfinite(curve.fit.ci_low):
+                with_interval = True
                 label += f" [{curve.fit.ci_low:.2f}, {curve.fit.ci_high:.2f}]"
             line_h = np.geomspace(min(h), max(h), 20)
             axes.plot(line_h, curve.fit.error_constant * line_h ** curve.fit.order, "--",
@@ -125,8 +128,11 @@ def error_against_h(curves, title, y_label, x_label="cell size h [m]"):
     axes.set_title(title)
     axes.grid(True, which="both", alpha=0.3)
     if all_h:
+        # The title claims what the labels show: an order only where one was
+        # fitted, an interval only where one exists (two levels have none).
+        title = ("series: least-squares order p" + (" [95% CI]" if with_interval else "")) if fitted else "series"
         axes.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0,
-                    title="series: least-squares order p [95% CI]", title_fontsize=8)
+                    title=title, title_fontsize=8)
     else:
         _no_data(axes)
     return figure

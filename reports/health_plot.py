@@ -44,6 +44,8 @@ def _has_finite(values):
 
 
 LINE_STYLES = ["-", "--", "-.", ":"]
+# A case with this many output times or fewer is drawn as markers, without lines.
+FEW_OUTPUT_TIMES = 2
 
 
 def run_health(curves, title):
@@ -72,9 +74,12 @@ def run_health(curves, title):
     ratio = axes[rows - 1, 0] if with_ratio else None
     drawn = {energy: False, distortion: False}
     for k, curve in enumerate(curves):
+        t = np.asarray(curve.time, float)
         line = dict(color=curve.style.colour, marker=curve.style.marker, markersize=4, linewidth=1.2,
                     linestyle=LINE_STYLES[(k // len(COLOURS)) % len(LINE_STYLES)])
-        t = np.asarray(curve.time, float)
+        if t.size <= FEW_OUTPUT_TIMES:
+            # Two points joined read as a trend the run never showed: markers alone.
+            line.update(linestyle="none", markersize=7)
         # log panels: a value that is not positive (no error at all, or NaN) is left out of the line
         for panel, values in ((energy, curve.energy_error), (distortion, curve.distortion)):
             positive = _positive(values)
@@ -92,12 +97,12 @@ def run_health(curves, title):
             for values, style in ((curve.holes, line["linestyle"]), (curve.holes_inside, ":")):
                 if _has_finite(values):
                     percent = 100.0 * np.asarray(values, float)
-                    holes.plot(t, percent, **{**line, "linestyle": style})
+                    holes.plot(t, percent, **_with_style(line, style))
                     _mark_stop(holes, curve, t, percent)
         if lift is not None:
             for values, style in ((curve.wave_ratio, line["linestyle"]), (curve.basis_stiffening, ":")):
                 if _has_finite(values):
-                    lift.plot(t, values, **{**line, "linestyle": style})
+                    lift.plot(t, values, **_with_style(line, style))
                     _mark_stop(lift, curve, t, values)
         if ratio is not None and curve.step_ratio is not None:
             ratio.plot(t, curve.step_ratio, **line)
@@ -144,6 +149,11 @@ def run_health(curves, title):
         energy.legend(handles, labels, fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)
     figures.suptitle(figure, title)
     return figure
+
+
+def _with_style(line, style):
+    """The line's settings with another line style, unless it draws markers alone."""
+    return line if line["linestyle"] == "none" else {**line, "linestyle": style}
 
 
 def _positive(values):

@@ -167,6 +167,7 @@ body { font-family: sans-serif; margin: 1.5em auto; max-width: 1400px; color: #2
 table { border-collapse: collapse; font-size: 0.85em; margin: 0.5em 0 1.5em; }
 th, td { border: 1px solid #ccc; padding: 2px 6px; text-align: left; vertical-align: top; }
 th { background: #f0f0f0; position: sticky; top: 0; }
+div.table { overflow-x: auto; max-width: 100%; }
 div.verdict { border-left: 6px solid #888; background: #f6f6f6; padding: 0.3em 1em; margin: 0.5em 0 1em; }
 div.verdict.pass { border-color: #1a7f37; background: #eef8f0; }
 div.verdict.fail { border-color: #c62828; background: #fdeeee; }
@@ -188,7 +189,9 @@ def html_table(table):
         css = f' class="{html.escape(table.css[index])}"' if table.css else ""
         body.append(f"<tr{css}>" + "".join(f"<td>{html.escape(cell)}</td>" for cell in row) + "</tr>")
     kind = f" class='{html.escape(table.kind)}'" if table.kind else ""
-    return f"<table{kind}><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
+    # A table wider than the page scrolls inside its own box (the uniaxial
+    # suite's measurements were cut at the window's edge).
+    return f"<div class='table'><table{kind}><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table></div>"
 
 
 def render_html(report):

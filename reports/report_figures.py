@@ -153,6 +153,11 @@ def stability_figure(study, all_series, directory):
         for case in series.cases:
             panel.cells[(row, case.keys[refine])] = stability_cell(case)
     end = series_end_time(all_series[0])
+    cells = [cell for panel in panels.values() for cell in panel.cells.values()]
+    if cells and all(cell.fraction == 1.0 and not cell.stopped for cell in cells):
+        # A map of one colour says less than a sentence.
+        return FigureEntry(study, None, f"{study}: every one of its {len(cells)} cases reached the end time "
+                                        f"{end:g} s with its solution kept (no stability map drawn).")
     figure = figures.stability_map(list(panels.values()), f"{study}: time reached [s] of end time {end:g} s and "
                                    f"why a run stopped", refine)
     path = saved(figure, directory, study, 'stability')

@@ -269,3 +269,19 @@ def test_folded_corner_domains_are_named_in_the_caption(tmp_path, drawn):
     assert "cells=32: " not in ring_caption.split("turned over")[1]
     cylinder_caption = next(line for line in markdown.splitlines() if line.startswith("_rz-cylinder: the run's health"))
     assert "turned over" not in cylinder_caption
+
+
+def test_few_output_times_are_markers_not_lines():
+    """Requirement: a case with one or two output times is drawn as markers
+    alone (two points joined read as a trend); more output times as lines."""
+    def curve(times):
+        t = np.asarray(times, float)
+        return health_plot.HealthCurve("case", t, 1e-3 + 0 * t, 1 - 0.1 * t, 1 + 0.1 * t, 0.1 + 0 * t, 1 + t,
+                                       holes=0.01 * t, holes_inside=0.005 * t)
+    few = health_plot.run_health([curve([0.5, 1.0])], "few")
+    many = health_plot.run_health([curve([0.25, 0.5, 0.75, 1.0])], "many")
+    for figure, style in ((few, "None"), (many, "-")):
+        lines = [line for axes in figure.axes for line in axes.get_lines() if len(line.get_xdata()) > 1
+                 and line.get_marker() not in ("None", "", None, "x")]
+        assert lines and all(line.get_linestyle() == style for line in lines if line.get_linestyle() != ":"
+                             or style == "None")

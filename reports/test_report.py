@@ -5,6 +5,7 @@ contact-pressure and load-approach figures and the measurements tables appear
 for the cases that have /probes/contact_pressure, /probes/history and
 /measurements, and only then."""
 import csv
+import dataclasses
 import re
 from pathlib import Path
 
@@ -16,6 +17,8 @@ from . import gate
 from . import report
 from . import report_rows
 from . import report_tables
+from . import orders
+from . import report_figures
 from .conftest import (HERTZ_END_TIME, HERTZ_SUITE, ROUNDOFF_SUITE, SYNTHETIC_SUITE, hertz_cases, hertz_exact_pressure,
                       hertz_half_width, hertz_load, record_calls, roundoff_cases, synthetic_ring_cases,
                       write_suite_directory)
@@ -427,3 +430,31 @@ def test_the_report_opens_with_the_gates_verdict(synthetic_report, tmp_path):
     directory = write_suite_directory(tmp_path / "ungated", ungated, synthetic_ring_cases())
     written, _ = render(directory, tmp_path / "ungated-report")
     assert written["markdown"].read_text().splitlines()[2].startswith("**Verdict: none. This suite has no [[expect]]")
+
+
+def test_the_order_legend_claims_only_what_its_labels_show():
+    """Requirement: the error figure's legend title promises a 95 % interval only
+    when some series has one (three levels or more), an order only when one was
+    fitted."""
+    two = orders.least_squares_order([0.1, 0.05], [1e-2, 2.5e-3])
+    three = orders.least_squares_order([0.1, 0.05, 0.025], [1e-2, 2.6e-3, 6e-4])
+
+    def title(fit):
+        levels = fit.levels if fit else 2
+        curve = figures.Curve("s", [0.1, 0.05, 0.025][:levels], [1e-2, 2.6e-3, 6e-4][:levels], fit=fit)
+        return figures.error_against_h([curve], "t", "E").axes[0].get_legend().get_title().get_text()
+
+    assert title(two) == "series: least-squares order p"
+    assert title(three) == "series: least-squares order p [95% CI]"
+    assert title(None) == "series"
+
+
+def test_a_stability_study_where_every_case_completed_is_a_sentence(tmp_path):
+    """Requirement: a stability map of one colour (every case reached its end
+    with its solution kept) is replaced by a sentence saying so."""
+    directory = write_suite_directory(tmp_path / "suite", SYNTHETIC_SUITE, synthetic_ring_cases())
+    every = report_figures.study_series(report.read_suite(directory), "ring")
+    assert report_figures.stability_figure("ring", every, tmp_path).path is not None   # a case failed
+    done = [dataclasses.replace(s, cases=tuple(c for c in s.cases if c.completed)) for s in every]
+    entry = report_figures.stability_figure("ring", done, tmp_path)
+    assert entry.path is None and "every one of its" in entry.caption and "reached the end time" in entry.caption
