@@ -60,6 +60,21 @@ QUANTITY_LABELS = {
 }
 
 
+# The same in the scene's own coordinates (the results file's `geometry`).
+GEOMETRY_QUANTITY_LABELS = {
+    ("plane-strain", "displacement_x"): "x displacement",
+    ("plane-strain", "displacement_y"): "y displacement",
+    ("axisymmetric", "displacement_x"): "radial displacement u_r",
+    ("axisymmetric", "displacement_y"): "axial displacement u_z",
+}
+
+
+def quantity_label(quantity, geometry=None):
+    """What a probe quantity is called in a scene of the given geometry
+    ("plane-strain" or "axisymmetric"; None: either, QUANTITY_LABELS)."""
+    return GEOMETRY_QUANTITY_LABELS.get((geometry, quantity), QUANTITY_LABELS.get(quantity, quantity))
+
+
 def probe_line_l1(simulated, exact):
     """Eq. 3.1 at every output time: mean over the line's points of |q_sim - q_exact|.
     simulated, exact: arrays T x P (or P); returns T values (or one)."""

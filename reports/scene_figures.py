@@ -29,20 +29,26 @@ def profile_snapshots(line):
             for k in chosen]
 
 
+def case_geometry(case):
+    """The results file's `geometry` attribute ("plane-strain" or "axisymmetric"), or None."""
+    geometry = case.attribute("geometry", None)
+    return None if geometry is None else str(geometry.decode() if isinstance(geometry, bytes) else geometry)
+
+
 def profile_figure(study, all_series, directory):
-    panels, line = [], None
+    panels, line, geometry = [], None, None
     for series in all_series:
         case = finest_completed(series)
         lines = read_probe_lines(case.results_path) if case else []
         if not lines or lines[0].time.size == 0:
             continue
-        line = lines[0]
+        line, geometry = lines[0], case_geometry(case)
         panels.append(figures.ProfilePanel(f"{series.label}\n{case.keys[series.refine]} {series.refine}",
                                            line.positions, profile_snapshots(line)))
     if not panels:
         return None
     unit = norms.QUANTITY_UNITS.get(line.quantity, "")
-    label = norms.QUANTITY_LABELS.get(line.quantity, line.quantity)
+    label = norms.quantity_label(line.quantity, geometry)
     figure = figures.profiles(panels, f"{study}: {label} along probe line {line.name}",
                               PARAMETER_LABELS.get(line.parameter, line.parameter), f"{label} [{unit}]", unit)
     path = saved(figure, directory, study, 'profile', line.name)
@@ -52,13 +58,13 @@ def profile_figure(study, all_series, directory):
 
 
 def history_figure(study, all_series, directory):
-    panels, history = [], None
+    panels, history, geometry = [], None, None
     for series in all_series:
         case = finest_completed(series)
         found = read_point_history(case.results_path) if case else None
         if found is None or found.time.size == 0:
             continue
-        history = found
+        history, geometry = found, case_geometry(case)
         where = ", ".join(f"{x:.3g}" for x in np.ravel(history.reference_position))
         panels.append(figures.ProfilePanel(f"{series.label}\n{case.keys[series.refine]} {series.refine}, "
                                            f"point ({where}) m", history.time,
@@ -66,7 +72,7 @@ def history_figure(study, all_series, directory):
     if not panels:
         return None
     unit = norms.QUANTITY_UNITS.get(history.quantity, "")
-    label = norms.QUANTITY_LABELS.get(history.quantity, history.quantity)
+    label = norms.quantity_label(history.quantity, geometry)
     figure = figures.profiles(panels, f"{study}: {label} at material point {history.name} over time",
                               "time t [s]", f"{label} [{unit}]", unit, markers=False)
     path = saved(figure, directory, study, 'history', history.name)

@@ -57,4 +57,8 @@ def test_units_and_descriptions_follow_the_line_quantity():
     assert norms.norm_unit("error_axial_stress", quantities) == "1"
     assert "relative error" in norms.describe_norm("error_axial_stress", quantities)
     assert "pressure" in norms.describe_norm("particle_pressure_L2", quantities)
+    # scene-aware names: r and z in r-z scenes
+    assert norms.quantity_label("displacement_x", "axisymmetric") == "radial displacement u_r"
+    assert norms.quantity_label("displacement_y", "plane-strain") == "y displacement"
+    assert norms.quantity_label("displacement_x") == "x (or r) displacement"
     assert "eq. 3.1" in norms.describe_norm("L1_theta0", quantities)
