@@ -30,6 +30,7 @@ from pathlib import Path
 from . import figure_parts
 from . import gate
 from . import orders
+from . import report_tables
 from .report_figures import external_comparison_figure, study_figures
 from .report_rows import LEVELS_CSV_COLUMNS, ORDERS_CSV_COLUMNS, gci_rows, order_rows, stored_norm_check
 from .report_tables import (case_table, expectation_table, gci_table, measurement_sections, orders_table,
@@ -51,6 +52,7 @@ class Report:
     figures: list                # FigureEntry
     verdicts: list = None        # the gate's, when the suite has expectations and they could be checked
     gate_error: str = ""         # why they could not be
+    glossary: str = ""           # what the tables' columns and classes mean, after the figures
 
 
 def status_counts(suite):
@@ -100,12 +102,10 @@ def build_report(suite, figure_directory, progress=None):
     sections += reference_sections(suite, rows)
     sections += measurement_sections(suite)
     fitted = [r for r in rows if len(r.levels) >= 2]
-    sections.append(("Observed orders", DEFINITIONS + f" {len(rows) - len(fitted)} of {len(rows)} (series, norm, "
-                     "time) combinations have fewer than two usable levels and are left out here. orders.csv has "
-                     "every row, with the columns " + "; ".join(f"{n} ({m})" for n, m in ORDERS_CSV_COLUMNS) +
-                     "; levels.csv each row's levels, one per line, with the columns " +
-                     "; ".join(f"{n} ({m})" for n, m in LEVELS_CSV_COLUMNS[6:]) + ".",
-                     orders_table(fitted)))
+    sections.append(("Observed orders", f"Each series' orders by norm and output time; the columns and classes "
+                     f"are defined in the glossary at the end. {len(rows) - len(fitted)} of {len(rows)} (series, "
+                     "norm, time) combinations have fewer than two usable levels and are left out here; orders.csv "
+                     "has every row.", orders_table(fitted)))
     sections.append(("Richardson extrapolation and grid convergence index",
                      "Roache's GCI (safety factor 1.25) of the point probe's simulated value on the three finest "
                      "completed levels of each series with a constant refinement ratio, at the output time where the "
@@ -113,6 +113,13 @@ def build_report(suite, figure_directory, progress=None):
                      "value is shown only to check the band f_fine (1 +- GCI). Convergence round-off: a change between "
                      f"two levels is at most ({orders.ROUNDOFF_ULPS} + steps) ulps of the point's |X| (pi for an "
                      "angle), which rounding alone can explain: no order, extrapolation or GCI.", gci_table(grid_rows)))
+    # Definitions once, at the end, rather than above every table they serve.
+    measured = any(title.startswith("Measurements: ") for title, _, _ in sections)
+    glossary = (DEFINITIONS + (" Measurements: " + report_tables.MEASUREMENTS_DEFINITION if measured else "") +
+                " orders.csv has every (series, norm, time) row, with the columns " +
+                "; ".join(f"{n} ({m})" for n, m in ORDERS_CSV_COLUMNS) +
+                "; levels.csv each row's levels, one per line, with the columns " +
+                "; ".join(f"{n} ({m})" for n, m in LEVELS_CSV_COLUMNS[6:]) + ".")
     entries, studies = [], suite.study_names()
     for done, study in enumerate(studies):
         if progress:
@@ -124,7 +131,7 @@ def build_report(suite, figure_directory, progress=None):
     if comparison is not None:
         entries.insert(0, comparison)
     return Report(suite, datetime.now(), status_counts(suite), stored_norm_check(suite), rows, grid_rows,
-                  sections, entries, verdicts, gate_error)
+                  sections, entries, verdicts, gate_error, glossary)
 
 
 def verdict_lines(report):
@@ -216,6 +223,8 @@ def render_html(report):
             data = base64.b64encode(entry.path.read_bytes()).decode()
             parts.append(f"<figure><img alt='{html.escape(entry.path.name)}' src='data:image/png;base64,{data}'>"
                          f"<figcaption>{html.escape(entry.caption)}</figcaption></figure>")
+    if report.glossary:
+        parts.append(f"<h2>Glossary</h2><p>{html.escape(report.glossary)}</p>")
     parts.append("</body></html>")
     return "\n".join(parts)
 
@@ -243,6 +252,8 @@ def render_markdown(report, output_directory):
                 continue
             lines += [f"![{entry.caption}]({entry.path.relative_to(output_directory).as_posix()})", "",
                       f"_{entry.caption}_", ""]
+    if report.glossary:
+        lines += ["## Glossary", "", report.glossary, ""]
     return "\n".join(lines)
 
 

@@ -81,15 +81,20 @@ def measurement_table(cases):
     return Table(["case"] + names, rows, kind="measurements")
 
 
+# What a Measurements section's columns are (the report's glossary).
+MEASUREMENTS_DEFINITION = ("the /measurements attributes of each case (4 significant digits; - where a case has "
+                           "none): what the scene measures at the end of the run; an attribute ending in _exact is "
+                           "the exact value of the one without the suffix, one ending in _error its relative error "
+                           "(reports/results-format.md).")
+
+
 def measurement_sections(suite):
     sections = []
     for study in suite.study_names():
         table = measurement_table(suite.cases_of(study))
         if table is not None:
-            sections.append((f"Measurements: {study}", f"The /measurements attributes of each case of study {study} "
-                             "(4 significant digits; - where a case has none): what the scene measures at the end "
-                             "of the run; an attribute ending in _exact is the exact value of the one without the "
-                             "suffix, one ending in _error its relative error (reports/results-format.md).", table))
+            sections.append((f"Measurements: {study}", f"What each case of study {study} measured at its end "
+                             "(glossary at the end).", table))
     return sections
 
 

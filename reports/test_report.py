@@ -160,7 +160,11 @@ def test_suite_without_contact_history_or_measurements_renders_as_before(synthet
     markdown = written["markdown"].read_text()
     assert re.findall(r"^## .*", markdown, re.M) == ["## Expectations", "## Cases", "## Observed orders",
                                                      "## Richardson extrapolation and grid convergence index",
-                                                     "## Figures"]
+                                                     "## Figures", "## Glossary"]
+    # the definitions once, in the glossary, not above the orders' table
+    orders_paragraph = markdown.split("## Observed orders", 1)[1].split("\n\n")[1]
+    assert "glossary" in orders_paragraph and "Norms: L1_" not in orders_paragraph
+    assert "Norms: L1_<line> is eq. 3.1" in markdown.split("## Glossary", 1)[1]
     assert "Measurements" not in written["html"].read_text()
 
 
