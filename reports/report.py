@@ -31,6 +31,7 @@ from . import figure_parts
 from . import gate
 from . import orders
 from . import report_tables
+from . import verdict_figure
 from .report_figures import external_comparison_figure, study_figures
 from .report_rows import LEVELS_CSV_COLUMNS, ORDERS_CSV_COLUMNS, gci_rows, order_rows, stored_norm_check
 from .report_tables import (case_table, expectation_table, gci_table, measurement_sections, orders_table,
@@ -53,6 +54,7 @@ class Report:
     verdicts: list = None        # the gate's, when the suite has expectations and they could be checked
     gate_error: str = ""         # why they could not be
     glossary: str = ""           # what the tables' columns and classes mean, after the figures
+    verdict_figure: object = None  # FigureEntry of every checked series against its band, under the verdict
 
 
 def status_counts(suite):
@@ -130,8 +132,9 @@ def build_report(suite, figure_directory, progress=None):
         progress(len(studies), len(studies), None)
     if comparison is not None:
         entries.insert(0, comparison)
+    summary = verdict_figure.verdict_figure(verdicts, figure_directory, suite.name) if verdicts else None
     return Report(suite, datetime.now(), status_counts(suite), stored_norm_check(suite), rows, grid_rows,
-                  sections, entries, verdicts, gate_error, glossary)
+                  sections, entries, verdicts, gate_error, glossary, summary)
 
 
 def verdict_lines(report):
@@ -201,6 +204,12 @@ def html_table(table):
     return f"<div class='table'><table{kind}><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table></div>"
 
 
+def _html_figure(entry):
+    data = base64.b64encode(entry.path.read_bytes()).decode()
+    return (f"<figure><img alt='{html.escape(entry.path.name)}' src='data:image/png;base64,{data}'>"
+            f"<figcaption>{html.escape(entry.caption)}</figcaption></figure>")
+
+
 def render_html(report):
     suite = report.suite
     parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(suite.name)}</title>"
@@ -209,6 +218,8 @@ def render_html(report):
     parts.append(f"<div class='verdict {kind}'><p><strong>{html.escape(verdict[0])}</strong></p>" +
                  ("<ul>" + "".join(f"<li>{html.escape(line)}</li>" for line in verdict[1:]) + "</ul>"
                   if len(verdict) > 1 else "") + "</div>")
+    if report.verdict_figure is not None:
+        parts.append(_html_figure(report.verdict_figure))
     parts += [f"<p>{html.escape(line)}</p>" for line in header_lines(report)]
     for title, text, table in report.sections:
         parts.append(f"<h2>{html.escape(title)}</h2><p>{html.escape(text)}</p>")
@@ -220,9 +231,7 @@ def render_html(report):
             if entry.path is None:
                 parts.append(f"<p class='left-out'><em>{html.escape(entry.caption)}</em></p>")
                 continue
-            data = base64.b64encode(entry.path.read_bytes()).decode()
-            parts.append(f"<figure><img alt='{html.escape(entry.path.name)}' src='data:image/png;base64,{data}'>"
-                         f"<figcaption>{html.escape(entry.caption)}</figcaption></figure>")
+            parts.append(_html_figure(entry))
     if report.glossary:
         parts.append(f"<h2>Glossary</h2><p>{html.escape(report.glossary)}</p>")
     parts.append("</body></html>")
@@ -240,6 +249,10 @@ def render_markdown(report, output_directory):
     lines = [f"# Convergence report: {report.suite.name}", ""]
     _, verdict = verdict_lines(report)
     lines += [f"**{verdict[0]}**", ""] + [f"- {line}" for line in verdict[1:]] + ([""] if len(verdict) > 1 else [])
+    if report.verdict_figure is not None:
+        entry = report.verdict_figure
+        lines += [f"![{entry.caption}]({entry.path.relative_to(output_directory).as_posix()})", "",
+                  f"_{entry.caption}_", ""]
     lines += [line + "\n" for line in header_lines(report)]
     for title, text, table in report.sections:
         lines += [f"## {title}", "", text, "", markdown_table(table) if table and table.rows else "_none_", ""]
@@ -276,7 +289,7 @@ def write_report(directory, output=None, progress=None):
     write_levels_csv(report.order_rows, written["levels"])
     write_gci_csv(report.gci_rows, written["gci"])
     write_summary(written["summary"], report)
-    return written, sum(e.path is not None for e in report.figures)
+    return written, sum(e.path is not None for e in report.figures) + (report.verdict_figure is not None)
 
 
 class _OneLineParser(argparse.ArgumentParser):

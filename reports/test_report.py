@@ -146,7 +146,7 @@ def test_gold_results_directory_renders_and_gates(tmp_path):
     assert gate.main([str(GOLD)]) in (0, 1)
 
 
-RING_FIGURES = ["ring-L1-over-time.png", "ring-error-L1_theta0-end.png", "ring-error-particle_L2-end.png",
+RING_FIGURES = ["gate-verdicts.png", "ring-L1-over-time.png", "ring-error-L1_theta0-end.png", "ring-error-particle_L2-end.png",
                 "ring-history-point_R1.png", "ring-profile-theta0.png", "ring-spectrum.png", "ring-stability.png", "ring-work-precision.png"]
 
 
@@ -430,10 +430,15 @@ def test_the_report_opens_with_the_gates_verdict(synthetic_report, tmp_path):
     assert markdown[4].startswith("- expectation 1 (ring, method=cpdi, L1_theta0 at t = ")
     assert "observed 2.000" in markdown[4] and "expected [2.9, 3.1]" in markdown[4]
     assert "<div class='verdict fail'>" in written["html"].read_text()
+    # under the verdict, the figure of every checked series against its band, before any section
+    page = written["html"].read_text()
+    assert page.index("alt='gate-verdicts.png'") < page.index("<h2>Expectations</h2>")
+    assert (tmp_path / "short-report" / "figures" / "gate-verdicts.png").is_file()
     ungated = SYNTHETIC_SUITE[:SYNTHETIC_SUITE.index("[[expect]]")]
     directory = write_suite_directory(tmp_path / "ungated", ungated, synthetic_ring_cases())
     written, _ = render(directory, tmp_path / "ungated-report")
     assert written["markdown"].read_text().splitlines()[2].startswith("**Verdict: none. This suite has no [[expect]]")
+    assert not (tmp_path / "ungated-report" / "figures" / "gate-verdicts.png").exists()
 
 
 def test_the_order_legend_claims_only_what_its_labels_show():
