@@ -269,8 +269,12 @@ def profiles(panels, title, x_label, y_label, unit, markers=True):
     return figure
 
 
-def error_spectra(panels, title, y_label):
-    """panels: list of (panel title, curves with x = mode m, y = amplitude)."""
+def error_spectra(panels, title, y_label, floors=None):
+    """panels: list of (panel title, curves with x = mode m, y = amplitude), each
+    mode a marker (the modes are discrete; no line joins them); floors: panel
+    title -> the round-off floor of an amplitude, drawn dotted, the axis
+    starting a decade below it so that the height goes to what is above it."""
+    floors = floors or {}
     figure, axes_list = _panel_grid(len(panels), width=5.2, height=4.0)
     for axes, (panel_title, curves) in zip(axes_list, panels):
         drawn = False
@@ -278,9 +282,23 @@ def error_spectra(panels, title, y_label):
             m, amplitude = np.asarray(curve.x, float), np.asarray(curve.y, float)
             keep = amplitude > 0
             if keep.any():
-                axes.plot(m[keep], amplitude[keep], marker=curve.style.marker, markersize=3,
-                          color=curve.style.colour, linewidth=1.0, label=curve.label)
+                axes.plot(m[keep], amplitude[keep], marker=curve.style.marker, markersize=4, linestyle="none",
+                          color=curve.style.colour, label=curve.label)
                 drawn = True
+        floor = floors.get(panel_title)
+        if drawn and floor is not None and floor > 0:
+            values = np.concatenate([np.asarray(c.y, float) for c in curves])
+            above = values[np.isfinite(values) & (values > floor)]
+            top = float(above.max()) if above.size else floor
+            # the axis from a decade under the smallest mode above the floor: the
+            # modes at round-off, below the floor, are not what the figure is for
+            bottom = max(float(above.min()) / 10.0, floor / 3.0) if above.size else floor / 10.0
+            if bottom <= floor:
+                axes.axhline(floor, color="black", linestyle=":", linewidth=1.0, label="round-off floor")
+            else:
+                axes.text(0.99, 0.02, f"round-off floor {floor:.1e}, below the axis", transform=axes.transAxes,
+                          ha="right", va="bottom", fontsize=7, color="grey")
+            axes.set_ylim(bottom=bottom, top=max(top * 3.0, floor * 10.0))
         if drawn:
             axes.set_yscale("log")
             axes.legend(fontsize=8)

@@ -8,6 +8,7 @@ import numpy as np
 from . import figures
 from . import health_plot
 from . import norms
+from . import orders
 from .figure_parts import FigureEntry, saved, split_label, time_text
 from .report_rows import PARAMETER_LABELS
 from .probes import (read_contact_pressure, read_error_spectrum, read_monitors, read_point_history, read_probe_lines,
@@ -82,7 +83,7 @@ def history_figure(study, all_series, directory):
 
 
 def spectrum_figure(study, all_series, styles, directory):
-    panels, quantity = {}, ""
+    panels, quantity, floors = {}, "", {}
     for series in all_series:
         candidates = [c for c in series.cases if c.results is not None]
         chosen = next(((c, s) for c in reversed(candidates) for s in [read_error_spectrum(c.results_path)] if s),
@@ -99,17 +100,25 @@ def spectrum_figure(study, all_series, styles, directory):
         curve = figures.Curve(label, np.arange(spectrum.amplitude.shape[1]), spectrum.amplitude[-1],
                               styles[series.label])
         panels.setdefault(problem, []).append(curve)
+        if quantity == "angular_displacement":
+            # an angle's round-off: (ROUNDOFF_ULPS + steps) ulps of pi (orders.roundoff_floor)
+            steps = float(case.attribute("steps", 0.0))
+            floor = orders.roundoff_floor(int(steps) if math.isfinite(steps) else 0, math.pi)
+            floors[problem] = max(floors.get(problem, 0.0), floor)
     if not panels:
         return None
     unit = norms.QUANTITY_UNITS.get(quantity, "")
     label = norms.QUANTITY_LABELS.get(quantity, quantity)
     figure = figures.error_spectra(list(panels.items()), f"{study}: angular spectrum of the {label} error on the "
-                                   f"material circle at the last output", f"amplitude of mode m [{unit}]")
+                                   f"material circle at the last output", f"amplitude of mode m [{unit}]", floors)
     path = saved(figure, directory, study, 'spectrum')
     return FigureEntry(study, path, f"{study}: amplitude of angular mode m of the {label} error around the material "
                                     f"circle (/probes/circle/error_spectrum) at the last output, finest case of each "
-                                    f"series that has one; the exact motion is axisymmetric, so m > 0 is lost "
-                                    f"axisymmetry.")
+                                    f"series that has one, one marker a mode; the exact motion is axisymmetric, so "
+                                    f"m > 0 is lost axisymmetry" + (f"; the round-off floor of an angle, "
+                                    f"({orders.ROUNDOFF_ULPS} + steps) ulps of pi, dotted (or named where it lies "
+                                    f"below the axis): no mode below it means anything, and the axis starts a decade "
+                                    f"under the smallest mode above it" if floors else "") + ".")
 
 
 def level_label(series, case):

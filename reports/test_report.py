@@ -467,3 +467,19 @@ def test_a_stability_study_where_every_case_completed_is_a_sentence(tmp_path):
     done = [dataclasses.replace(s, cases=tuple(c for c in s.cases if c.completed)) for s in every]
     entry = report_figures.stability_figure("ring", done, tmp_path)
     assert entry.path is None and "every one of its" in entry.caption and "reached the end time" in entry.caption
+
+
+def test_spectra_are_markers_over_the_round_off_floor():
+    """Requirement: the error spectrum draws each mode as a marker (no line joins
+    discrete modes) and starts its axis a decade under the smallest mode above
+    the round-off floor, the floor dotted when within the axis and named when
+    below it."""
+    near = figures.Curve("near", [0, 1, 2, 3], [1e-3, 1e-12, 1e-16, 1e-5])
+    far = figures.Curve("far", [0, 1, 2], [1e-3, 1e-4, 1e-17])
+    figure = figures.error_spectra([("near", [near]), ("far", [far])], "t", "A", {"near": 1e-13, "far": 1e-13})
+    near_axes, far_axes = figure.axes[:2]
+    assert all(line.get_linestyle() == "None" for line in near_axes.get_lines() if line.get_label() == "near")
+    assert near_axes.get_ylim()[0] == pytest.approx(1e-13 / 3.0)          # 1e-12 / 10 is under floor / 3
+    assert any(line.get_label() == "round-off floor" for line in near_axes.get_lines())
+    assert far_axes.get_ylim()[0] == pytest.approx(1e-5)                  # a decade under 1e-4
+    assert any("below the axis" in text.get_text() for text in far_axes.texts)
