@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -278,4 +279,20 @@ TEST_F(Cli, ThreadsWaitPassivelyUnlessTheRunNamesAPolicy) {
     const mpmvv::h5::File f = mpmvv::h5::File::open_read(file.string());
     EXPECT_EQ(f.root().attribute_string("omp_wait_policy"), expected) << environment;
   }
+}
+
+// The per-run table names each column's unit under it ([1] for a ratio), and
+// the results file keeps the same units in /errors' "units" attribute.
+TEST_F(Cli, TheRunsTableAndResultsNameEachColumnsUnit) {
+  const Outcome o = mpmvv("run " + ring_scene() + " -q -t 1 --set cells=24 --set end_time=0.01 -o " + results());
+  ASSERT_EQ(o.status, 0) << o.err;
+  const std::vector<std::string> lines = lines_of(o.out);
+  const auto header = std::find_if(lines.begin(), lines.end(), [](const std::string& l) { return l.find("t [s]") != std::string::npos; });
+  ASSERT_NE(header, lines.end());
+  ASSERT_NE(header + 1, lines.end());
+  for (const char* unit : {"[rad]", "[m]", "[Pa]", "[m/s]", "[1]"}) EXPECT_NE(header[1].find(unit), std::string::npos) << unit;
+  const mpmvv::h5::File f = mpmvv::h5::File::open_read((directory_ / "x.h5").string());
+  const std::string units = f.root().open_group("errors").attribute_string("units");
+  EXPECT_NE(units.find("L1_theta0 rad\n"), std::string::npos) << units;
+  EXPECT_NE(units.find("particle_pressure_L2 Pa\n"), std::string::npos) << units;
 }

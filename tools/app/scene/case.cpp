@@ -211,11 +211,12 @@ class Case final : public SceneCase, private RunObserver {
   // motion, the scene's own.
   void start_error_table() {
     errors_ = ErrorTable{};
-    for (const ProbeLine& line : setup_.lines) errors_.add_column("L1_" + line.name);
+    for (const ProbeLine& line : setup_.lines) add_error_column("L1_" + line.name);
     if (setup_.exact_motion)
-      for (const char* name : kParticleNorms) errors_.add_column(name);
-    for (const std::string& name : setup_.extra_error_names) errors_.add_column(name);
+      for (const char* name : kParticleNorms) add_error_column(name);
+    for (const std::string& name : setup_.extra_error_names) add_error_column(name);
   }
+  void add_error_column(const std::string& name) { errors_.add_column(name, error_unit(name, setup_.lines)); }
 
   // The energy at the start, for the balance (monitors.hpp), and the first
   // point of the time-integrated error.

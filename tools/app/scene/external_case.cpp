@@ -214,9 +214,11 @@ class ExternalCase final : public SceneCase {
     // A program that follows no tracers gets them placed from its particles.
     interpolated_tracers_ = !fields_.tracers && !probes_.tracer_references().empty();
     if (fields_.tracers || interpolated_tracers_)
-      for (const ProbeLine& line : setup_.lines) errors_.add_column("L1_" + line.name);
+      for (const ProbeLine& line : setup_.lines)
+        errors_.add_column("L1_" + line.name, error_unit("L1_" + line.name, setup_.lines));
     for (std::size_t c = 0; c < std::size(kParticleNorms); ++c)
-      if (norm_given(kParticleNorms[c], fields_)) errors_.add_column(kParticleNorms[c]);
+      if (norm_given(kParticleNorms[c], fields_))
+        errors_.add_column(kParticleNorms[c], error_unit(kParticleNorms[c], setup_.lines));
     // The exact state at t = 0, as mpmvv seeds it (case.cpp: initial).
     Particles at_start = first.P;
     for (std::size_t p = 0; p < at_start.size(); ++p)

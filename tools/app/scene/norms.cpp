@@ -8,6 +8,19 @@
 
 namespace mpmvv::app {
 
+std::string error_unit(const std::string& column, const std::vector<ProbeLine>& lines) {
+  for (const ProbeLine& line : lines)
+    if (column == "L1_" + line.name) return line.quantity == ProbeQuantity::angular_displacement ? "rad" : "m";
+  static constexpr std::pair<const char*, const char*> kUnits[] = {
+      {"particle_L1", "m"},          {"particle_L2", "m"},
+      {"particle_Linf", "m"},        {"particle_pressure_L2", "Pa"},
+      {"particle_deformation_L2", "1"}, {"particle_velocity_L2", "m/s"},
+      {"exact_displacement_L2", "m"}, {"particle_relative_L2_integrated", "1"}};
+  for (const auto& [name, unit] : kUnits)
+    if (column == name) return unit;
+  return column.rfind("error_", 0) == 0 ? "1" : "";
+}
+
 const char* norm_definitions() {
   return "L1_<line>: eq. 3.1 of 000_1dbcb8acb6dddab9.txt, the mean over the line's material points of "
          "|q_sim - q_exact| for the line's quantity (its 'quantity' attribute; rad or m); particle_L1, "

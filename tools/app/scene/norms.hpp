@@ -27,6 +27,11 @@ inline constexpr const char* kParticleNorms[] = {
 // What every column means (eq. 3.1 of 000_1dbcb8acb6dddab9.txt for the lines).
 const char* norm_definitions();
 
+// The unit of an /errors column: a line's L1 in its quantity's (rad or m),
+// the particle norms' own (m, Pa, m/s; 1 for F and the time-integrated
+// relative norm), 1 for a scene's relative error_* columns.
+std::string error_unit(const std::string& column, const std::vector<ProbeLine>& lines);
+
 // Sums over the particles, weighted by reference volume V_p0, of the
 // displacement error e_p = |x_p - x_exact(X_p, t)| (e, e^2, its largest)
 // and of the exact displacement |x_exact - X_p|^2.

@@ -140,6 +140,11 @@ void write_results_file(const std::string& path, const RunIdentity& request, con
 void write_errors(h5::Group& root, const ErrorTable& errors, const std::string& description) {
   h5::Group e = root.create_group("errors");
   e.set_attribute("description", description);
+  // Each column's unit, "name unit" a line (norms.hpp: error_unit).
+  std::string units;
+  for (std::size_t k = 0; k < errors.columns.size() && k < errors.units.size(); ++k)
+    units += errors.columns[k].first + " " + (errors.units[k].empty() ? "-" : errors.units[k]) + "\n";
+  e.set_attribute("units", units);
   e.write("time", errors.time, {errors.time.size()});
   for (const auto& [name, values] : errors.columns) e.write(name, values, {values.size()});
 }

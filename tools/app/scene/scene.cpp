@@ -193,14 +193,19 @@ const std::vector<double>& ErrorTable::column(const std::string& name) const {
   throw std::out_of_range("no error column '" + name + "'");
 }
 
-std::vector<double>& ErrorTable::add_column(const std::string& name) {
+std::vector<double>& ErrorTable::add_column(const std::string& name, const std::string& unit) {
   columns.emplace_back(name, std::vector<double>{});
+  units.push_back(unit);
   return columns.back().second;
 }
 
 void print_error_table(std::ostream& out, const ErrorTable& errors) {
   fmt::print(out, "{:>8}", "t [s]");
   for (const auto& [name, values] : errors.columns) fmt::print(out, " {:>14}", name);
+  fmt::print(out, "\n{:>8}", "");
+  // Under each name its unit; "[1]" marks a ratio (a relative error, F's error).
+  for (std::size_t k = 0; k < errors.columns.size(); ++k)
+    fmt::print(out, " {:>14}", k < errors.units.size() && !errors.units[k].empty() ? "[" + errors.units[k] + "]" : "");
   fmt::print(out, "\n");
   for (std::size_t k = 0; k < errors.time.size(); ++k) {
     fmt::print(out, "{:>8.4g}", errors.time[k]);

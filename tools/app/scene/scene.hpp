@@ -24,15 +24,17 @@ namespace mpmvv::app {
 struct ErrorTable {
   std::vector<double> time;
   std::vector<std::pair<std::string, std::vector<double>>> columns;
+  std::vector<std::string> units;  // one a column (norms.hpp: error_unit); "1" for a relative error
 
   const std::vector<double>& column(const std::string& name) const;  // throws when there is none
   const std::vector<double>* find(const std::string& name) const;     // null when there is none
-  std::vector<double>& add_column(const std::string& name);
+  std::vector<double>& add_column(const std::string& name, const std::string& unit = "");
 
   template <class Archive>
   void persist(Archive& a) {
     a.field("time", time);
     a.field("columns", columns);
+    a.field("units", units);
   }
 };
 
