@@ -109,11 +109,23 @@ def stored_l1_discrepancy(stored, recomputed):
     return float(np.nan_to_num(difference, nan=np.inf).max()) if difference.size else 0.0
 
 
+class LineQuantities(dict):
+    """Probe line name -> its quantity, and in .units the unit of each /errors
+    column as the results files stored it (the solver's norms.hpp: error_unit)."""
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.units = {}
+
+
 def norm_unit(norm, line_quantities):
     """Unit of an /errors column: m for particle displacement norms, Pa for the
     pressure, m/s for the velocity, 1 for F and for relative errors (the
     time-integrated relative norm and a scene's error_* columns, results-format.md),
-    the line's quantity unit for L1_<line>."""
+    the line's quantity unit for L1_<line>. The unit the results files stored
+    comes first; the rules below serve files written before they stored one."""
+    stored = getattr(line_quantities, "units", {})
+    if norm in stored:
+        return stored[norm]
     if norm in PARTICLE_NORMS:
         return "m"
     if norm in RELATIVE_NORMS or norm in DEFORMATION_NORMS or norm.startswith("error_"):

@@ -120,10 +120,13 @@ def error_columns(cases):
 
 
 def line_quantities(cases):
-    merged = {}
+    """The probe lines' quantities of the cases (name -> quantity), with the units
+    their results files stored for the /errors columns (.units; norms.norm_unit)."""
+    merged = norms.LineQuantities()
     for case in cases:
         if case.results:
             merged.update(case.results.line_quantities)
+            merged.units.update(case.results.error_units)
     return merged
 
 

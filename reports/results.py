@@ -46,6 +46,7 @@ class CaseResults:
     measurements: dict = field(default_factory=dict)   # /measurements attributes: name -> value
     settling: dict = field(default_factory=dict)       # /settling attributes, its norms under "norms"
     external: dict = field(default_factory=dict)       # /external attributes (another program's run)
+    error_units: dict = field(default_factory=dict)    # /errors column name -> the unit the run stored (its `units`)
 
 
 @dataclass(frozen=True)
@@ -234,6 +235,13 @@ def read_case_results(path):
                 if values.ndim != 1 or values.shape != error_times.shape:
                     raise ValueError(f"/errors/{name} has shape {values.shape}, not one value per output time "
                                      f"{error_times.shape}")
+        # "name unit" a line (results-format.md); "-" for a column without one; absent in older files.
+        error_units = {}
+        if errors_group is not None:
+            for line in plain(errors_group.attrs.get("units", "")).splitlines():
+                name, _, unit = line.rpartition(" ")
+                if name:
+                    error_units[name] = "" if unit == "-" else unit
         line_quantities = {}
         for name, group in f.get("probes", {}).items():
             quantity = plain(group.attrs.get("quantity", ""))
@@ -252,7 +260,7 @@ def read_case_results(path):
         external_group = f.get("external")
         external = ({name: plain(value) for name, value in external_group.attrs.items()}
                     if isinstance(external_group, h5py.Group) else {})
-    return CaseResults(attributes, error_times, errors, line_quantities, measurements, settling, external)
+    return CaseResults(attributes, error_times, errors, line_quantities, measurements, settling, external, error_units)
 
 
 def lookup_error(case, norm, time):

@@ -62,3 +62,23 @@ def test_units_and_descriptions_follow_the_line_quantity():
     assert norms.quantity_label("displacement_y", "plane-strain") == "y displacement"
     assert norms.quantity_label("displacement_x") == "x (or r) displacement"
     assert "eq. 3.1" in norms.describe_norm("L1_theta0", quantities)
+
+
+def test_the_unit_a_results_file_stored_comes_first(tmp_path):
+    """Requirement: a column's unit is the one the run stored in /errors' units
+    attribute (the solver's rule, written once there); the report's own rule
+    serves files written before it stored one."""
+    import h5py
+    from .conftest import write_case_results
+    from .results import read_case_results
+    path = tmp_path / "case.h5"
+    write_case_results(path, {"cells": 8}, 0.1, {"L1_theta0": [1e-3], "error_custom": [1e-2]}, [1.0])
+    assert read_case_results(path).error_units == {}                     # written before units were stored
+    with h5py.File(path, "a") as f:
+        f["errors"].attrs["units"] = "L1_theta0 rad\nerror_custom 1\nweird -\n"
+    stored = read_case_results(path).error_units
+    assert stored == {"L1_theta0": "rad", "error_custom": "1", "weird": ""}
+    quantities = norms.LineQuantities({"theta0": "radial_displacement"})
+    quantities.units.update(stored)
+    assert norms.norm_unit("L1_theta0", quantities) == "rad"            # stored, over the line's quantity (m)
+    assert norms.norm_unit("L1_theta0", {"theta0": "radial_displacement"}) == "m"
