@@ -147,10 +147,11 @@ def verdict_lines(report):
     if report.verdicts is None:
         return "fail", [f"Verdict: not checked: {report.gate_error}"]
     summary = gate.summary_line(report.verdicts, len(suite.expectations))
+    summary = summary[0].upper() + summary[1:]
     short = [v for v in report.verdicts if not v.passed]
     if not short:
-        return "pass", [f"Verdict: PASS. {summary[0].upper() + summary[1:]}."]
-    lines = [f"Verdict: FAIL. {summary[0].upper() + summary[1:]}:"]
+        return "pass", [f"Verdict: PASS. {summary}."]
+    lines = [f"Verdict: FAIL. {summary}:"]
     for v in short:
         row = dict(zip(gate.HEADER, gate.verdict_row(v)))
         lines.append(f"expectation {row['#']} ({row['study']}, {row['series']}, {row['norm']} at t = {row['t']}): "

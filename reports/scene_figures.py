@@ -32,8 +32,7 @@ def profile_snapshots(line):
 
 def case_geometry(case):
     """The results file's `geometry` attribute ("plane-strain" or "axisymmetric"), or None."""
-    geometry = case.attribute("geometry", None)
-    return None if geometry is None else str(geometry.decode() if isinstance(geometry, bytes) else geometry)
+    return case.attribute("geometry", None)  # decoded as read (results.plain)
 
 
 def profile_figure(study, all_series, directory):
