@@ -325,10 +325,11 @@ def main(argv):
             except OSError as error:
                 print(f"mpmvv gate: cannot write {path}: {error.strerror}", file=sys.stderr)
                 return 2
+    name = suite.name if suite.tier == "full" else f"{suite.name} ({suite.tier} tier)"
     if not suite.expectations:
-        print(f"{suite.name}: no [[expect]] in the suite; nothing to check")
+        print(f"{name}: no [[expect]] in the suite; nothing to check")
         return 0
-    print(f"{suite.name}: {len(suite.expectations)} expectations")
+    print(f"{name}: {len(suite.expectations)} expectations")
     print(format_table([verdict_row(v) for v in verdicts]))
     print(summary_line(verdicts, len(suite.expectations)))
     return 0 if all(v.passed for v in verdicts) else 1

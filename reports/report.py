@@ -163,8 +163,11 @@ def header_lines(report):
     suite = report.suite
     counts = ", ".join(f"{n} {s}" for s, n in report.status_counts.items())
     checked, largest = report.norm_check
+    tier = ("the full study" if suite.tier == "full" else
+            "the ci tier: the cheap levels and expectations every merge runs (the full study has more)")
     return [
         suite.description or "(no description in suite.toml)",
+        f"Tier: {tier}.",
         f"Directory {suite.directory}; manifest written {suite.written:%Y-%m-%d %H:%M}; report generated "
         f"{report.generated:%Y-%m-%d %H:%M}.",
         f"{len(suite.cases)} cases: {counts}.",

@@ -108,6 +108,7 @@ class Suite:
     expectations_recorded: bool = True                 # False: a manifest written before it recorded them
     references: list = field(default_factory=list)     # [[reference]] tables of suite.toml (references.py)
     cases: list = field(default_factory=list)
+    tier: str = "full"                                 # the tier that ran (suites/README.md, "Tiers")
 
     def study_names(self):
         names = [s.get("name") for s in self.studies if isinstance(s.get("name"), str)]
@@ -117,9 +118,19 @@ class Suite:
         return [c for c in self.cases if c.study == study]
 
     def varied_keys(self, study):
-        """The keys the study's [[study]] table sweeps and zips, in file order."""
+        """The keys the study's [[study]] table sweeps and zips in the tier that
+        ran, in file order (a `ci` table's keys take the place of the study's own)."""
         table = next((s for s in self.studies if s.get("name") == study), {})
-        return [key for part in ("sweep", "zip") if isinstance(table.get(part), dict) for key in table[part]]
+        parts = {part: list(table[part]) if isinstance(table.get(part), dict) else [] for part in ("sweep", "zip")}
+        ci = table.get("ci")
+        if self.tier == "ci" and isinstance(ci, dict):
+            tables = {part: ci[part] if isinstance(ci.get(part), dict) else {} for part in ("set", "sweep", "zip")}
+            fixed = set(tables["set"])
+            parts["sweep"] = [k for k in parts["sweep"] if k not in fixed] + \
+                [k for k in tables["sweep"] if k not in parts["sweep"]]
+            if tables["zip"]:
+                parts["zip"] = list(tables["zip"])
+        return parts["sweep"] + parts["zip"]
 
 
 def read_suite(directory):
@@ -133,6 +144,9 @@ def read_suite(directory):
     suite_file = _read_suite_file(suite_path) if suite_path.is_file() else {}
     studies = suite_file.get("study", [])
     references = suite_file.get("reference", [])
+    tier = manifest.get("tier", "full")
+    if tier not in ("full", "ci"):
+        raise SuiteDirectoryError(f"{manifest_path}: 'tier' is {tier!r}; a suite's tiers are 'full' and 'ci'")
     if not all(isinstance(tables, list) for tables in (studies, references)):
         raise SuiteDirectoryError(f"{suite_path}: 'study' and 'reference' must be arrays of tables "
                                   "([[study]], [[reference]])")
@@ -150,8 +164,11 @@ def read_suite(directory):
         studies=studies,
         expectations=expectations,
         expectations_recorded="expectations" in manifest,
-        references=references,
+        # Published numbers sit beside the full study's levels, which the
+        # ci tier does not run (mpmvv suite checks them in the full tier).
+        references=references if tier == "full" else [],
         cases=[_read_case(directory, entry) for entry in manifest["cases"]],
+        tier=tier,
     )
 
 

@@ -248,3 +248,35 @@ def test_a_lost_case_is_not_completed_anywhere(tmp_path, capsys):
     table = report_tables.case_table(suite)
     cells = next(r for r in table.rows if r[0] == "ring-method=cpdi-cells=64")
     assert cells[1] == "lost" and "health_J_factor" in cells[3]
+
+
+def test_ci_tier_is_named_and_its_table_sets_the_varied_keys(tmp_path, capsys):
+    """Requirement: a manifest of the ci tier is read as such: the gate names the
+    tier, the study's `ci` table decides which keys vary (a key the ci tier sets is
+    not varied there; one it sweeps is), references are the full tier's, and a
+    tier that is neither is refused with one line."""
+    suite_toml = SYNTHETIC_SUITE.replace(
+        'sweep = { method = ["linear", "cpdi"], cells = [32, 64, 128, 256] }',
+        'sweep = { method = ["linear", "cpdi"], cells = [32, 64, 128, 256] }\n'
+        'ci = { set = { method = "cpdi" }, sweep = { cells = [32, 64, 128], particles_per_direction = [2] } }')
+    suite_toml += '\n[[reference]]\nsource = "x"\nstudy = "ring"\nquantity = "time_reached"\n' \
+                  'columns = ["cells"]\nrows = [[32, 1.0]]\n'
+    cases = [c for c in synthetic_ring_cases(linear_fails_at_64=False)
+             if c["keys"]["method"] == "cpdi" and c["keys"]["cells"] <= 128]
+    directory = write_suite_directory(tmp_path / "ci", suite_toml, cases)
+    manifest = json.loads((directory / "manifest.json").read_text())
+    manifest["tier"] = "ci"
+    (directory / "manifest.json").write_text(json.dumps(manifest))
+    suite = read_suite(directory)
+    assert suite.tier == "ci" and suite.references == []
+    assert suite.varied_keys("ring") == ["cells", "particles_per_direction"]
+    status, out, _ = run_gate(directory, capsys)
+    assert status == 0 and out.startswith("synthetic (ci tier): 1 expectations")
+    manifest["tier"] = "quick"
+    (directory / "manifest.json").write_text(json.dumps(manifest))
+    status, _, err = run_gate(directory, capsys)
+    assert status == 2 and "'tier' is 'quick'" in err and err.count("\n") == 1
+    del manifest["tier"]
+    (directory / "manifest.json").write_text(json.dumps(manifest))
+    suite = read_suite(directory)
+    assert suite.tier == "full" and suite.varied_keys("ring") == ["method", "cells"] and len(suite.references) == 1

@@ -191,3 +191,79 @@ TEST(SuiteFile, WarnsOfAReadWhereTheExactSignalIsTrivial) {
   EXPECT_NE(loaded.warnings[0].find("particle_L2 at t = 1 where the exact signal is 0 %"), std::string::npos)
       << loaded.warnings[0];
 }
+
+// A study's ci table takes the place of its own keys in the ci tier: a swept
+// key keeps its place in the id, a set key may be swept and a swept one set;
+// a study without one is left out; each tier keeps only its expectations.
+TEST(SuiteFile, CiTierReplacesTheStudysKeys) {
+  const fs::path dir = scratch("ci-tier");
+  const fs::path suite = write(
+      dir / "s.toml",
+      "[[study]]\nname = \"r\"\nscene = \"" + kScenes + "/ring.toml\"\n"
+      "set = { end_time = 0.25, particles_per_direction = 2 }\n"
+      "sweep = { method = [\"gimp\", \"cpdi\"], cells = [32, 64, 128] }\n"
+      "ci = { set = { method = \"cpdi\", end_time = 0.1 }, sweep = { cells = [24, 32], particles_per_direction = [1, 2] } }\n"
+      "[[study]]\nname = \"full-only\"\nscene = \"" + kScenes + "/ring.toml\"\nsweep = { cells = [32, 64] }\n"
+      "[[expect]]\nstudy = \"r\"\nnorm = \"particle_L2\"\nlevels = [64, 128]\norder = 2.0\ntolerance = 0.5\n"
+      "[[expect]]\nstudy = \"r\"\nnorm = \"particle_L2\"\nmax_error = 0.1\ntier = [\"full\", \"ci\"]\n"
+      "[[expect]]\nstudy = \"r\"\nnorm = \"L1_theta0\"\nlevels = [24, 32]\norder = 2.0\ntolerance = 0.5\ntier = \"ci\"\n");
+  const mpmvv::app::Suite full = mpmvv::app::load_suite(suite.string());
+  EXPECT_EQ(full.tier, "full");
+  EXPECT_EQ(full.cases.size(), 8u);
+  ASSERT_EQ(full.expectations.size(), 2u);
+  EXPECT_EQ(full.expectations[0]["order"], 2.0);
+  const mpmvv::app::Suite ci = mpmvv::app::load_suite(suite.string(), mpmvv::app::kCiTier);
+  EXPECT_EQ(ci.tier, "ci");
+  ASSERT_EQ(ci.cases.size(), 4u);
+  EXPECT_EQ(ci.cases[0].id, "r-cells=24-particles_per_direction=1");
+  EXPECT_EQ(ci.cases[3].id, "r-cells=32-particles_per_direction=2");
+  for (const auto& c : ci.cases) {
+    EXPECT_EQ(c.keys.at("method"), "cpdi") << c.id;
+    EXPECT_EQ(c.keys.at("end_time"), 0.1) << c.id;
+  }
+  ASSERT_EQ(ci.expectations.size(), 2u);
+  EXPECT_EQ(ci.expectations[0]["max_error"], 0.1);
+  EXPECT_EQ(ci.expectations[1]["norm"], "L1_theta0");
+}
+
+// The ci tier's mistakes are named: an expectation there on a study the tier
+// leaves out, levels the tier does not run, an unknown tier; a suite that
+// says it has no ci tier is skipped with its reason, and one with no ci
+// study is refused.
+TEST(SuiteFile, CiTierMistakesAreNamed) {
+  const fs::path dir = scratch("ci-mistakes");
+  const std::string study = "[[study]]\nname = \"r\"\nscene = \"" + kScenes + "/ring.toml\"\nsweep = { cells = [32, 64] }\n";
+  auto ci_error = [&](const std::string& name, const std::string& text) {
+    try {
+      mpmvv::app::load_suite(write(dir / name, text).string(), mpmvv::app::kCiTier);
+    } catch (const ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_NE(ci_error("left-out.toml", study + "[[expect]]\nstudy = \"r\"\nnorm = \"particle_L2\"\nmax_error = 1.0\ntier = \"ci\"\n")
+                .find("no study has a ci tier"),
+            std::string::npos);
+  const std::string with_ci = study + "ci = { sweep = { cells = [24, 32] } }\n"
+                              "[[study]]\nname = \"q\"\nscene = \"" + kScenes + "/ring.toml\"\n";
+  EXPECT_NE(ci_error("not-in-tier.toml", with_ci + "[[expect]]\nstudy = \"q\"\nnorm = \"particle_L2\"\nmax_error = 1.0\ntier = \"ci\"\n")
+                .find("applies in the ci tier, where study 'q' does not run"),
+            std::string::npos);
+  EXPECT_NE(ci_error("levels.toml", with_ci + "[[expect]]\nstudy = \"r\"\nnorm = \"particle_L2\"\nlevels = [32, 64]\n"
+                                               "order = 2.0\ntolerance = 0.5\ntier = \"ci\"\n")
+                .find("study 'r' has no case with cells = 64"),
+            std::string::npos);
+  const std::string bad_tier = ci_error("bad-tier.toml", with_ci + "[[expect]]\nstudy = \"r\"\nnorm = \"particle_L2\"\n"
+                                                                   "max_error = 1.0\ntier = \"quick\"\n");
+  EXPECT_NE(bad_tier.find("bad-tier.toml:"), std::string::npos) << bad_tier;
+  EXPECT_NE(bad_tier.find("'tier' must be \"full\", \"ci\""), std::string::npos) << bad_tier;
+  EXPECT_NE(ci_error("bad-ci.toml", study + "ci = { sweep = { cells = [24] }, levels = [24] }\n").find("levels"), std::string::npos);
+  const fs::path skipped = write(dir / "skip.toml", "[ci]\nskip = \"needs another program\"\n" + study);
+  try {
+    mpmvv::app::load_suite(skipped.string(), mpmvv::app::kCiTier);
+    ADD_FAILURE() << "a suite without a ci tier loaded its ci tier";
+  } catch (const mpmvv::app::SuiteSkipped& e) {
+    EXPECT_NE(std::string(e.what()).find("needs another program"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(mpmvv::app::load_suite(skipped.string()).cases.size(), 2u);
+}

@@ -1,7 +1,8 @@
 // Throughput of the explicit step on the ring scene: particle-steps per second
 // for each shape-function family and thread count, best of several repeats.
 // The run is the real scene (body force, tracers, output) from t = 0 over a
-// short interval, so the number is what `mpmvv run` delivers.
+// short interval, so the number is what `mpmvv run` delivers (centre
+// seeding: estimate.hpp, ring_rate_run, says why).
 //
 //   mpmvv-bench-throughput [--cells 256] [--end-time 0.1] [--repeats 3] [--threads 1,2] [--set KEY=VALUE]
 //
@@ -18,7 +19,7 @@
 
 #include "solver/parallel.hpp"
 #include "solver/shape/cpdi_lanes.hpp"
-#include "tools/app/scene/scene.hpp"
+#include "tools/app/suite/estimate.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"Particle-steps per second of the explicit MPM step on the ring scene."};
@@ -58,18 +59,10 @@ int main(int argc, char** argv) {
       std::size_t particles = 0;
       std::string stopped;
       for (int r = 0; r < repeats; ++r) {
-        mpmvv::app::Config config("ring", mpmvv::app::find_scene_type("ring")->keys());
-        // Centre seeding: the exact seeding's slivers at the rims (particles
-        // of 3e-4 of a full one) stop linear MPM and exact CPDI at t = 0.034 s
-        // on 256 cells, and a rate measured over a run that stops is not the
-        // rate of the method (--set seeding=exact measures them all the same).
-        for (const std::string& o : {"method=" + method, "scheme=" + scheme, "cells=" + std::to_string(cells),
-                                     std::string("seeding=centre"), fmt::format("end_time={}", end_time),
-                                     fmt::format("output_times={}", end_time)})
-          config.set_from_text(o);
-        for (const std::string& o : extra) config.set_from_text(o);
-        auto scene = mpmvv::app::find_scene_type("ring")->build(config);
-        const mpmvv::RunOutcome o = scene->run({});
+        std::vector<std::string> settings{"method=" + method, "scheme=" + scheme, "cells=" + std::to_string(cells),
+                                          fmt::format("end_time={}", end_time)};
+        settings.insert(settings.end(), extra.begin(), extra.end());
+        const mpmvv::RunOutcome o = mpmvv::app::ring_rate_run(settings, &particles);
         // A run the solver stops still measures the steps it took; the row says so.
         if (!o.completed) stopped = fmt::format("  (stopped at t = {:.3g} s: {})", o.failure_time, o.failure_reason);
         const double rate = double(o.particle_steps) / o.wall_seconds;
@@ -78,7 +71,6 @@ int main(int argc, char** argv) {
           best = o;
         }
         steps = o.steps;
-        particles = scene->particle_count();
       }
       // Each stage's wall time per particle-step; "other" is the rest of the
       // run's wall time (the time loop, output, work ledgers, domains turned or split).

@@ -105,7 +105,18 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 1024));
   suite_cmd->add_option("-o,--output", suite.output_dir, "output directory; default results/<suite name>")->type_name("DIR");
   suite_cmd->add_flag("-q,--quiet", suite.quiet, "no progress");
-  suite_cmd->add_flag("--list", suite.list, "check the suite and list its cases with their settings; run nothing");
+  suite_cmd->add_flag("--list", suite.list,
+                      "check the suite and list its cases with their settings and estimated run times; run nothing");
+  suite_cmd->add_option("--tier", suite.tier,
+                        "which tier of the suite: 'full' (the whole study) or 'ci' (the cheap tier every merge runs: "
+                        "its studies' `ci` tables and the expectations marked tier = \"ci\"); default full, output "
+                        "in results/<suite name>-ci for ci")
+      ->type_name("TIER");
+  suite_cmd->add_option("--budget", suite.budget_seconds,
+                        "a wall time in seconds: say which cases a run of that length (with -j) will not reach, from "
+                        "the estimates --list prints")
+      ->type_name("SECONDS")
+      ->check(CLI::PositiveNumber);
   suite_cmd->add_option("--only", suite.only,
                         "run (or list) only the cases whose id this regular expression finds, e.g. 'cells=(300|600)-'; "
                         "the others stay as an earlier run left them (pending, or kept)")

@@ -52,6 +52,17 @@ struct RestartPlan {
   std::function<void(const std::string& message, bool failed)> tell;
 };
 
+// What a run of a case will take, known before it runs: its particles (the
+// body's area over the particle spacing squared) and its steps (end time over
+// a fixed step, or over the step at rest, cfl h / c0 with the material's
+// p-wave speed c0: a run whose waves speed up takes more, which
+// suite/estimate.hpp measures).
+struct WorkEstimate {
+  std::size_t particles = 0;
+  long long steps = 0;
+  bool implicit = false;  // steps are load steps, each a Newton solve
+};
+
 // One configured case of a scene, ready to run.
 class SceneCase {
  public:
@@ -70,6 +81,9 @@ class SceneCase {
   // Cell size, for the results file.
   virtual double cell_size() const = 0;
   virtual std::size_t particle_count() const = 0;
+  // The work of the run before it runs (`mpmvv suite --list`); none where the
+  // case cannot say (another program's run).
+  virtual std::optional<WorkEstimate> estimate() const { return std::nullopt; }
   virtual Geometry geometry() const = 0;
   // How the body force is evaluated ("derived", "closed form"), or "none".
   virtual std::string body_force_kind() const = 0;

@@ -35,6 +35,24 @@ void warn_of_a_trivial_read(const toml::table& e, const std::string& here, const
         100.0 * *fraction));
 }
 
+// Whether expectation `e` applies in `tier`: its `tier` names a tier or
+// lists them ("full", "ci"); an expectation without one is the full study's.
+bool in_tier(const toml::table& e, const std::string& path, const std::string& tier) {
+  const toml::node* t = e.get("tier");
+  if (!t) return tier == kFullTier;
+  std::vector<std::string> tiers;
+  if (t->is_string()) tiers.push_back(t->as_string()->get());
+  if (t->is_array())
+    for (const toml::node& n : *t->as_array())
+      if (n.is_string()) tiers.push_back(n.as_string()->get());
+  const bool well_formed = !tiers.empty() && (t->is_string() || tiers.size() == t->as_array()->size()) &&
+                           std::all_of(tiers.begin(), tiers.end(), [](const std::string& s) { return s == kFullTier || s == kCiTier; });
+  if (!well_formed)
+    throw ConfigError(fmt::format("{}: [[expect]]: 'tier' must be \"{}\", \"{}\" or a list of them", where_in(path, *t),
+                                  kFullTier, kCiTier));
+  return std::find(tiers.begin(), tiers.end(), tier) != tiers.end();
+}
+
 }  // namespace
 
 void read_expectations(const toml::table& top, const std::string& path, const std::map<std::string, Study>& studies,
@@ -47,12 +65,17 @@ void read_expectations(const toml::table& top, const std::string& path, const st
     const toml::table& e = *node.as_table();
     const std::string here = where_in(path, node);
     expect_only(e, {"study", "where", "norm", "time", "refine", "levels", "order", "tolerance", "max_error_constant",
-                    "max_error", "at_roundoff", "must_complete", "interval_within_band"},
+                    "max_error", "at_roundoff", "must_complete", "interval_within_band", "tier"},
                 path, "[[expect]]");
+    if (!in_tier(e, path, suite.tier)) continue;
     const toml::node* study = e.get("study");
     if (!study || !study->is_string()) throw ConfigError(fmt::format("{}: [[expect]] needs the study it checks", here));
     const std::string name = study->as_string()->get();
     if (!studies.count(name)) throw ConfigError(fmt::format("{}: [[expect]]: no study named '{}'", where_in(path, *study), name));
+    if (!studies.at(name).in_tier)
+      throw ConfigError(fmt::format("{}: [[expect]] applies in the {} tier, where study '{}' does not run (give the "
+                                    "study a `ci` table)",
+                                    here, suite.tier, name));
     const std::vector<KeySpec>& specs = studies.at(name).keys;
     auto is_key = [&](const std::string& k) {
       return std::any_of(specs.begin(), specs.end(), [&](const KeySpec& s) { return s.name == k; });

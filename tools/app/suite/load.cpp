@@ -18,13 +18,43 @@ namespace mpmvv::app {
 namespace fs = std::filesystem;
 using namespace suite_file;
 
-Suite load_suite(const std::string& path) {
+namespace {
+
+// The suite's [ci] table: `covers`, what its ci tier checks that no other
+// tier does (suites/README.md's table says it for every suite), or `skip`,
+// why the suite has no ci tier. Asking a skipped suite for its ci tier
+// throws SuiteSkipped with that reason.
+void read_ci_table(const toml::table& top, const std::string& path, Suite& suite) {
+  const toml::node* node = top.get("ci");
+  if (!node) return;
+  const toml::table& ci = table_at(*node, path, "ci");
+  expect_only(ci, {"covers", "skip"}, path, "[ci]");
+  for (const auto& [key, value] : ci) {
+    if (!value.is_string() || value.as_string()->get().empty())
+      throw ConfigError(fmt::format("{}: [ci] '{}' must be a sentence (a string)", where_in(path, value), key.str()));
+    (key.str() == "covers" ? suite.ci_covers : suite.ci_skip) = value.as_string()->get();
+  }
+  if (!suite.ci_covers.empty() && !suite.ci_skip.empty())
+    throw ConfigError(fmt::format("{}: [ci] gives both 'covers' and 'skip': a suite has a ci tier or says why not",
+                                  where_in(path, *node)));
+  if (suite.tier == kCiTier && !suite.ci_skip.empty())
+    throw SuiteSkipped(fmt::format("{}: no ci tier: {}", path, suite.ci_skip));
+}
+
+}  // namespace
+
+Suite load_suite(const std::string& path, const std::string& tier) {
+  if (tier != kFullTier && tier != kCiTier)
+    throw ConfigError(fmt::format("--tier {}: a suite has the tiers '{}' and '{}'", tier, kFullTier, kCiTier));
   if (!fs::exists(path)) throw ConfigError(fmt::format("{}: no such suite file", path));
   const toml::table top = parse_toml_file(path);
-  expect_only(top, {"description", "timeout", "checkpoint_every", "study", "expect", "reference"}, path, "the suite");
+  expect_only(top, {"description", "timeout", "checkpoint_every", "ci", "study", "expect", "reference"}, path,
+              "the suite");
   Suite suite;
   suite.file = path;
   suite.name = fs::path(path).stem().string();
+  suite.tier = tier;
+  read_ci_table(top, path, suite);
   if (const toml::node* d = top.get("description")) {
     if (!d->is_string()) throw ConfigError(fmt::format("{}: 'description' must be a string", where_in(path, *d)));
     suite.description = d->as_string()->get();
@@ -48,8 +78,14 @@ Suite load_suite(const std::string& path) {
 
   std::map<std::string, Study> studies;
   for (const toml::node& node : *studies_node->as_array()) studies.insert(expand_study(node, path, studies, suite));
+  if (suite.cases.empty())  // only the ci tier can leave every study out
+    throw ConfigError(fmt::format("{}: no study has a ci tier (a `ci` table: `ci = {{}}` runs the study as it is "
+                                  "there, `ci = {{ sweep = {{ cells = [16, 32] }} }}` on fewer levels)",
+                                  path));
   read_expectations(top, path, studies, suite);
-  check_references(top, path, studies, suite);
+  // Published numbers sit beside the full study's levels; the ci tier's
+  // report leaves them out (the full tier's load checks them).
+  if (tier == kFullTier) check_references(top, path, studies, suite);
   return suite;
 }
 

@@ -21,8 +21,10 @@
 
 #include <fmt/format.h>
 #include <fmt/ostream.h>
+#include <fmt/ranges.h>
 
 #include "case_process.hpp"
+#include "estimate.hpp"
 #include "manifest.hpp"
 #include "progress.hpp"
 #include "ranks.hpp"
@@ -40,17 +42,60 @@ namespace {
 volatile sig_atomic_t interrupted = 0;
 void on_interrupt(int) { interrupted = 1; }
 
-void list_cases(const Suite& suite, const std::function<bool(const SuiteCase&)>& selected, std::ostream& out) {
-  fmt::print(out, "suite {}: {} cases, timeout {} s{}\n", suite.file, suite.cases.size(), suite.timeout_seconds,
-             suite.description.empty() ? "" : "\n" + suite.description);
-  for (const SuiteCase& c : suite.cases) {
-    if (!selected(c)) continue;
-    std::string settings;
-    for (const std::string& o : c.overrides)
-      settings += o.find(' ') == std::string::npos ? " --set " + o : " --set '" + o + "'";
-    fmt::print(out, "{:<48} {}{}\n", c.id, c.scene_file, settings);
+// The estimated total of a plan, and with a budget the cases it leaves out.
+void print_plan_total(const Suite& suite, const std::vector<PlannedCase>& plan, int jobs, int threads, double budget,
+                      std::ostream& out) {
+  double total = 0.0, wall = 0.0;
+  int unknown = 0, over = 0;
+  std::vector<std::string> unreached;
+  for (const PlannedCase& p : plan) {
+    if (!p.estimate.seconds) {
+      ++unknown;
+      continue;
+    }
+    total += *p.estimate.seconds;
+    wall = std::max(wall, p.end);
+    over += *p.estimate.seconds > suite.timeout_seconds;
+    if (budget > 0.0 && p.end > budget) unreached.push_back(p.c->id);
   }
+  fmt::print(out, "estimated: {} of case time, about {} of wall time with {} case{} at once on {} thread{} each{}{}\n",
+             duration(total), duration(wall), jobs, jobs > 1 ? "s" : "", threads, threads > 1 ? "s" : "",
+             unknown ? fmt::format(", not counting {} case{} not estimated", unknown, unknown > 1 ? "s" : "") : "",
+             over ? fmt::format("; {} case{} past the timeout", over, over > 1 ? "s" : "") : "");
+  if (budget > 0.0)
+    fmt::print(out, "{}\n",
+               unreached.empty()
+                   ? fmt::format("budget {}: every estimated case ends within it", duration(budget))
+                   : fmt::format("budget {}: {} case{} would not end within it: {}", duration(budget), unreached.size(),
+                                 unreached.size() > 1 ? "s" : "", fmt::join(unreached, ", ")));
 }
+
+// Each selected case with its settings and an estimate of its run time
+// (estimate.hpp), then the suite's total and its wall time with `jobs` cases
+// at once; with a budget, the cases a run of that wall time will not reach.
+void list_cases(const Suite& suite, const std::vector<PlannedCase>& plan, int jobs, int threads, double budget,
+                const SuiteDirectory& dir, std::ostream& out) {
+  fmt::print(out, "suite {} ({} tier): {} cases, timeout {} s{}\n", suite.file, suite.tier, suite.cases.size(),
+             suite.timeout_seconds, suite.description.empty() ? "" : "\n" + suite.description);
+  fmt::print(out, "{:<48} {:>10} {:>8} {:>10}  {}\n", "case", "particles", "steps", "estimate", "settings; estimate from");
+  for (const PlannedCase& p : plan) {
+    const CaseEstimate& e = p.estimate;
+    std::string settings;
+    for (const std::string& o : p.c->overrides)
+      settings += o.find(' ') == std::string::npos ? " --set " + o : " --set '" + o + "'";
+    std::string notes;
+    if (e.seconds && *e.seconds > suite.timeout_seconds) notes += " (over the suite's timeout)";
+    if (budget > 0.0 && e.seconds && p.end > budget) notes += " (past the budget)";
+    fmt::print(out, "{:<48} {:>10} {:>8} {:>10}  {}{}; {}{}\n", p.c->id,
+               e.particles ? fmt::format("{}", *e.particles) : "-", e.steps ? fmt::format("{}", *e.steps) : "-",
+               e.seconds ? duration(*e.seconds) : "-", p.c->scene_file, settings, e.basis, notes);
+  }
+  print_plan_total(suite, plan, jobs, threads, budget, out);
+  fmt::print(out, "(each study and method calibrated on an earlier run in {} or on its cheapest case run now: "
+                  "estimate.hpp)\n",
+             dir.root.string());
+}
+
 // One suite at a time on a directory: a second would rename the first's
 // partial files and rewrite its manifest. The lock (flock on DIR/.lock, held
 // until this process exits, not by the cases it starts) is released by the
@@ -67,11 +112,19 @@ std::string claim_directory(const SuiteDirectory& dir, const Suite& suite, bool 
                        dir.root.string(), lock_file.string());
   // The descriptor stays open, and the lock held, until this process exits.
   if (fs::exists(dir.manifest()) && !force) {
-    const std::string other = member<std::string>(read_json(dir.manifest()), "suite", suite.name);
+    const Json manifest = read_json(dir.manifest());
+    const std::string other = member<std::string>(manifest, "suite", suite.name);
     if (other != suite.name)
       return fmt::format("-o {}: the directory holds the results of suite '{}' (its manifest.json); choose "
                          "another directory, or --force to run '{}' there and replace that manifest",
                          dir.root.string(), other, suite.name);
+    // A manifest written before tiers existed is the full tier's.
+    const std::string other_tier = member<std::string>(manifest, "tier", kFullTier);
+    if (other_tier != suite.tier)
+      return fmt::format("-o {}: the directory holds the {} tier of suite '{}'; choose another directory, or "
+                         "--force to run the {} tier there and replace that manifest (cases of the same "
+                         "configuration are kept)",
+                         dir.root.string(), other_tier, suite.name, suite.tier);
   }
   return "";
 }
@@ -239,7 +292,11 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
   }
   Suite suite;
   try {
-    suite = load_suite(request.suite_file);
+    suite = load_suite(request.suite_file, request.tier);
+  } catch (const SuiteSkipped& e) {
+    // A suite that needs a program built elsewhere: nothing to run, not a fault.
+    if (ranks.first()) fmt::print(err, "mpmvv suite: skipped: {}\n", e.what());
+    return 0;
   } catch (const ConfigError& e) {
     if (ranks.first()) fmt::print(err, "mpmvv suite: {}\n", e.what());
     return 2;
@@ -263,11 +320,20 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
                  request.only, suite.file, suite.cases.empty() ? std::string() : suite.cases.front().id);
     return 2;
   }
+  const SuiteDirectory dir{!request.output_dir.empty() ? fs::path(request.output_dir)
+                           : suite.tier == kFullTier ? fs::path("results") / suite.name
+                                                     : fs::path("results") / (suite.name + "-" + suite.tier)};
+  const int cores = std::max(1u, std::thread::hardware_concurrency());
+  const int jobs = std::max(1, request.jobs);
+  const int threads = request.threads > 0 ? request.threads : std::max(1, cores / (jobs * ranks.count()));
   if (request.list) {
-    if (ranks.first()) list_cases(suite, selected, out);
+    if (ranks.first()) list_cases(suite, plan_cases(suite, selected, dir, jobs, threads, err), jobs, threads,
+                                  request.budget_seconds, dir, out);
     return 0;
   }
-  const SuiteDirectory dir{request.output_dir.empty() ? fs::path("results") / suite.name : fs::path(request.output_dir)};
+  if (request.budget_seconds > 0.0 && ranks.first())
+    print_plan_total(suite, plan_cases(suite, selected, dir, jobs, threads, err), jobs, threads, request.budget_seconds,
+                     err);
   std::error_code ec;
   fs::create_directories(dir.cases(), ec);
   if (ec) {
@@ -287,9 +353,6 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
   const std::string prefix = ranks.count() > 1 ? fmt::format("[rank {}] ", ranks.rank()) : "";
   CaseQueue cases(suite, dir, err, request.quiet, prefix);
   cases.share(ranks.rank(), ranks.count(), selected);
-  const int cores = std::max(1u, std::thread::hardware_concurrency());
-  const int jobs = std::max(1, request.jobs);
-  const int threads = request.threads > 0 ? request.threads : std::max(1, cores / (jobs * ranks.count()));
   const bool passive = jobs * ranks.count() > 1 || request.threads > 0;  // threads set: others share the cores
   const std::string exe = self_executable();
   Progress progress(err, request.quiet, prefix, jobs);

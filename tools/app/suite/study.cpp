@@ -18,7 +18,7 @@ std::pair<std::string, Study> expand_study(const toml::node& node, const std::st
   static const std::regex name_pattern("[A-Za-z0-9_-]+");
   const toml::table& study = *node.as_table();
   const std::string here = where_in(path, node);
-  expect_only(study, {"name", "scene", "set", "sweep", "zip", "override"}, path, "[[study]]");
+  expect_only(study, {"name", "scene", "set", "sweep", "zip", "override", "ci"}, path, "[[study]]");
   const toml::node* name_node = study.get("name");
   if (!name_node || !name_node->is_string())
     throw ConfigError(fmt::format("{}: [[study]] needs a name (a string)", here));
@@ -54,6 +54,43 @@ std::pair<std::string, Study> expand_study(const toml::node& node, const std::st
   std::vector<Axis> sweep, zip;
   if (const toml::node* s = study.get("sweep")) sweep = axes_of(table_at(*s, path, "sweep"), path, specs, scene_config.scene(), "sweep");
   if (const toml::node* s = study.get("zip")) zip = axes_of(table_at(*s, path, "zip"), path, specs, scene_config.scene(), "zip");
+  // The study's ci tier (suites/README.md): its `ci` table's keys take the
+  // place of the study's own; a study without one is not in that tier.
+  const toml::node* ci_node = study.get("ci");
+  if (ci_node) {
+    const toml::table& ci = table_at(*ci_node, path, "ci");
+    expect_only(ci, {"set", "sweep", "zip"}, path, "a study's ci table");
+    if (suite.tier == kCiTier) {
+      std::vector<Setting> ci_set;
+      std::vector<Axis> ci_sweep;
+      if (const toml::node* s = ci.get("set")) ci_set = settings_of(table_at(*s, path, "ci set"), path, specs, scene_config.scene(), "ci set");
+      if (const toml::node* s = ci.get("sweep")) ci_sweep = axes_of(table_at(*s, path, "ci sweep"), path, specs, scene_config.scene(), "ci sweep");
+      if (const toml::node* s = ci.get("zip")) zip = axes_of(table_at(*s, path, "ci zip"), path, specs, scene_config.scene(), "ci zip");
+      const auto replaced = [&](const std::string& key) {
+        return std::any_of(ci_set.begin(), ci_set.end(), [&](const Setting& s) { return s.key == key; }) ||
+               std::any_of(ci_sweep.begin(), ci_sweep.end(), [&](const Axis& a) { return a.key == key; });
+      };
+      // A key moved between set and sweep leaves where it was; a swept key
+      // swept again keeps its place in the id.
+      fixed.erase(std::remove_if(fixed.begin(), fixed.end(), [&](const Setting& s) { return replaced(s.key); }), fixed.end());
+      sweep.erase(std::remove_if(sweep.begin(), sweep.end(),
+                                 [&](const Axis& a) {
+                                   return std::any_of(ci_set.begin(), ci_set.end(), [&](const Setting& s) { return s.key == a.key; });
+                                 }),
+                  sweep.end());
+      for (Axis& c : ci_sweep) {
+        const auto at = std::find_if(sweep.begin(), sweep.end(), [&](const Axis& a) { return a.key == c.key; });
+        if (at == sweep.end()) continue;
+        *at = c;
+        c.key.clear();
+      }
+      ci_sweep.erase(std::remove_if(ci_sweep.begin(), ci_sweep.end(), [](const Axis& a) { return a.key.empty(); }),
+                     ci_sweep.end());
+      fixed.insert(fixed.end(), ci_set.begin(), ci_set.end());
+      sweep.insert(sweep.end(), ci_sweep.begin(), ci_sweep.end());
+    }
+  }
+  if (suite.tier == kCiTier && !ci_node) return {name, Study{specs, nullptr, false}};
   std::size_t zip_length = zip.empty() ? 1 : zip.front().values.size();
   for (const Axis& a : zip)
     if (a.values.size() != zip_length)
@@ -154,7 +191,7 @@ std::pair<std::string, Study> expand_study(const toml::node& node, const std::st
       counter[a] = 0;
     }
   }
-  return {name, Study{specs, std::move(first)}};
+  return {name, Study{specs, std::move(first), true}};
 }
 
 }  // namespace mpmvv::app::suite_file

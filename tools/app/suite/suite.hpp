@@ -6,6 +6,7 @@
 #include <iosfwd>
 #include <map>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -24,10 +25,22 @@ struct SuiteCase {
   std::map<std::string, Json> keys;  // every resolved scene key: a number, a string or a list of numbers
 };
 
+// A suite's tiers (suites/README.md): the full study, and the cheap one every
+// merge runs (each study's `ci` table says its cases there; each expectation's
+// `tier` whether it applies there).
+inline constexpr const char* kFullTier = "full";
+inline constexpr const char* kCiTier = "ci";
+
 struct Suite {
   std::string name;         // file stem
   std::string file;
   std::string description;
+  std::string tier = kFullTier;  // the tier loaded: its cases and its expectations only
+  // The suite's [ci] table: what its ci tier covers that the others do not,
+  // or, for a suite without one, why (`skip`: it needs a program built
+  // elsewhere). Empty where the file says nothing.
+  std::string ci_covers;
+  std::string ci_skip;
   double timeout_seconds = 3600.0;
   // Wall time between the saves of each case's state (mpmvv run
   // --checkpoint-every), so that a case longer than a sitting goes on where it
@@ -44,8 +57,15 @@ struct Suite {
 };
 
 // Reads and checks a suite file and every case it makes; throws ConfigError
-// with the file, line and key of the first mistake. Nothing runs.
-Suite load_suite(const std::string& path);
+// with the file, line and key of the first mistake. Nothing runs. `tier`:
+// kFullTier or kCiTier (a suite that has no ci tier is refused for it, naming
+// why when its [ci] table's `skip` says so: SuiteSkipped).
+Suite load_suite(const std::string& path, const std::string& tier = kFullTier);
+
+// The ci tier asked of a suite that declares it has none ([ci] skip = "...").
+struct SuiteSkipped : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 
 // The environment variable through which a suite tells each case it starts
 // its process id: the case asks the kernel for SIGTERM when that process ends
@@ -60,6 +80,8 @@ struct SuiteRequest {
   bool quiet = false;
   bool list = false;         // check the suite and print its cases; run nothing
   std::string only;          // a regular expression: run (or list) only the cases whose id it finds; "" all
+  std::string tier = kFullTier;
+  double budget_seconds = 0.0;  // > 0: say which cases a run of that wall time will not reach (estimate.hpp)
   bool force = false;        // run in a directory that holds another suite's results (its manifest is replaced)
 };
 
