@@ -267,3 +267,23 @@ TEST(SuiteFile, CiTierMistakesAreNamed) {
   }
   EXPECT_EQ(mpmvv::app::load_suite(skipped.string()).cases.size(), 2u);
 }
+
+// Every shipped suite loads in both tiers, and has a ci tier with an
+// expectation there, or says why it has none ([ci] skip).
+TEST(SuiteFile, EveryShippedSuiteHasACiTier) {
+  int suites = 0;
+  for (const fs::directory_entry& entry : fs::directory_iterator(std::string(MPMVV_SOURCE_DIR) + "/suites")) {
+    if (entry.path().extension() != ".toml") continue;
+    ++suites;
+    const std::string file = entry.path().string();
+    const mpmvv::app::Suite full = mpmvv::app::load_suite(file);
+    if (!full.ci_skip.empty()) {
+      EXPECT_THROW(mpmvv::app::load_suite(file, mpmvv::app::kCiTier), mpmvv::app::SuiteSkipped) << file;
+      continue;
+    }
+    EXPECT_FALSE(full.ci_covers.empty()) << file << ": [ci] covers says what its ci tier checks";
+    const mpmvv::app::Suite ci = mpmvv::app::load_suite(file, mpmvv::app::kCiTier);
+    EXPECT_FALSE(ci.expectations.empty()) << file << ": a ci tier without an expectation checks nothing";
+  }
+  EXPECT_GE(suites, 19);
+}
