@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <string_view>
 #include <vector>
 
 #include "../model.hpp"
@@ -22,8 +23,19 @@ class FaultState {
   }
 
   bool is(SolverFault f) const { return fault_ == f; }
-  // cpdi-gradient's factor on the CPDI corner gradients; 1 otherwise.
-  double gradient_scale() const { return is(SolverFault::cpdi_gradient) ? kFaultyCpdiGradientScale : 1.0; }
+  // The factor on the shape gradients: cpdi-gradient's on CPDI's corner
+  // gradients, linear-gradient's and gimp-gradient's on the hats' and uGIMP's
+  // (each shape takes the factor of its own fault, `name` its Shape::name);
+  // 1 otherwise.
+  double gradient_scale(const char* name) const {
+    if (is(SolverFault::cpdi_gradient)) return kFaultyCpdiGradientScale;
+    const std::string_view shape = name;
+    if (is(SolverFault::linear_gradient) && shape == "linear") return kFaultyGridGradientScale;
+    if (is(SolverFault::gimp_gradient) && shape == "gimp") return kFaultyGridGradientScale;
+    return 1.0;
+  }
+  // cpdi-shear-sign's sign on the cross terms of s^-T; 1 otherwise.
+  double shear_sign() const { return is(SolverFault::cpdi_shear_sign) ? -1.0 : 1.0; }
 
   // Around a transfer that updates F and V: deformation-transpose applies the
   // update's increment transposed, frozen-volume keeps V_p0.
@@ -34,16 +46,41 @@ class FaultState {
     if (is(SolverFault::deformation_transpose)) transpose_deformation_increments(P, held_deformation_);
     if (is(SolverFault::frozen_volume)) P.volume = P.reference_volume;
   }
+  // Around the constitutive update: non-objective-stress forms the stress
+  // from the symmetric part of F and puts F back after.
+  void before_constitutive_update(Particles& P) {
+    if (is(SolverFault::non_objective_stress)) symmetric_deformation(P, held_true_deformation_);
+  }
   // After the constitutive update: kirchhoff-stress, no-hoop-stress.
-  void after_constitutive_update(Particles& P) const {
+  void after_constitutive_update(Particles& P) {
+    if (is(SolverFault::non_objective_stress)) P.deformation_gradient.swap(held_true_deformation_);
     if (is(SolverFault::kirchhoff_stress)) stress_times_dilatation(P);
     if (is(SolverFault::no_hoop_stress)) std::fill(P.hoop_stress.begin(), P.hoop_stress.end(), 0.0);
   }
   // lagged-stress, after the whole stress update: the stress just updated is
   // held back for one step, and the forces of the next step weigh the one
   // before it.
+  // A split (split.hpp) may have changed the particle count since the stress
+  // was held: the particles new since then hold their current stress (a
+  // split's halves keep their parent's, and a half that keeps the parent's
+  // index its held one).
   void after_stress_update(Particles& P) {
-    if (is(SolverFault::lagged_stress)) P.stress.swap(held_stress_);
+    if (!is(SolverFault::lagged_stress)) return;
+    const std::size_t held = held_stress_.size();
+    if (held != P.stress.size()) {
+      held_stress_.resize(P.stress.size());
+      for (std::size_t p = held; p < P.stress.size(); ++p) held_stress_[p] = P.stress[p];
+    }
+    P.stress.swap(held_stress_);
+  }
+  // apic-transpose, after a velocity update that forms C_p.
+  void after_velocity_update(Particles& P) const {
+    if (is(SolverFault::apic_transpose)) transpose_affine_velocities(P);
+  }
+  // traction-factor, after the tractions' evaluation.
+  void after_traction(std::vector<Vec2>& force) const {
+    if (is(SolverFault::traction_factor))
+      for (Vec2& f : force) f *= kFaultyTractionScale;
   }
   // The time the body force is read at for a step from t: under
   // lagged-force-time the time of the evaluation before.
@@ -83,6 +120,7 @@ class FaultState {
   // (lagged-force-time) and the first scan's signal speed (frozen-time-step).
   std::vector<Mat2> held_deformation_;
   std::vector<Mat2> held_stress_;
+  std::vector<Mat2> held_true_deformation_;  // non-objective-stress: F while the stress reads sym F
   double force_time_ = std::numeric_limits<double>::infinity();
   mutable double first_signal_speed_ = 0.0;
 };

@@ -49,8 +49,9 @@ template <class Shape>
 class GridConditions {
  public:
   // Takes the constraints and the contact master out of `stages`.
-  GridConditions(const GridGeometry& grid, const Particles& P, SceneStages& stages, bool swapped_walls)
-      : swapped_walls_(swapped_walls),
+  GridConditions(const GridGeometry& grid, const Particles& P, SceneStages& stages, SolverFault fault)
+      : swapped_walls_(fault == SolverFault::swapped_walls),
+        mirrored_wall_(fault == SolverFault::mirrored_wall),
         unresolved_mass_(unresolved_node_mass<Shape>(P)),
         constraints_(std::move(stages.constraints)),
         rest_(stages.rest_points.empty()
@@ -63,8 +64,9 @@ class GridConditions {
     if (damping_ > 0.0) fixed_components_ = prescribed_components(grid.node_count(), constraints_);
   }
 
-  // The walls (stages.hpp), or under swapped-walls the tangential component held.
-  void walls(const GridGeometry& grid, GridFields& g) const { apply_walls(grid, g, swapped_walls_); }
+  // The walls (stages.hpp), or under swapped-walls the tangential component
+  // held, under mirrored-wall the normal one reflected.
+  void walls(const GridGeometry& grid, GridFields& g) const { apply_walls(grid, g, swapped_walls_, mirrored_wall_); }
 
   // After a velocity-only map (USF, MUSL): the walls, the prescribed node
   // motion and the rest points on the grid velocity. (Those passes see
@@ -125,6 +127,7 @@ class GridConditions {
   }
 
   bool swapped_walls_;  // the swapped-walls fault (faults.hpp)
+  bool mirrored_wall_;  // the mirrored-wall fault (faults.hpp)
   double unresolved_mass_;  // [kg] a node's mass at or below this is empty (unresolved_node_mass)
   std::vector<NodeConstraint> constraints_;
   std::optional<RestPoints> rest_;  // absent without rest points

@@ -41,7 +41,7 @@ class ExplicitStages : public Stepper {
         materials_{material, std::move(second_material), stages.second_material_from},
         body_force_(std::move(stages.body_force)),
         traction_(std::move(stages.traction)),
-        grid_(model_.grid, model_.particles, stages, settings.fault == SolverFault::swapped_walls),
+        grid_(model_.grid, model_.particles, stages, settings.fault),
         bodies_(stages.second_body, model_.grid.node_count(), max_threads()) {
     buffers_.resize(max_threads(), model_.grid.node_count());
     if constexpr (requires { Shape::total_lagrangian; }) tracer_reference_ = model_.tracers;
@@ -64,9 +64,10 @@ class ExplicitStages : public Stepper {
   }
 
   Shape bind(const Particles& P, const Mat2* domain_deformation = nullptr) const {
-    Shape shape = Shape::bind(model_.grid, P, domain_deformation, faults_.gradient_scale());
+    Shape shape = Shape::bind(model_.grid, P, domain_deformation, faults_.gradient_scale(Shape::name));
     if constexpr (requires { shape.weight_skew; })
       if (faults_.is(SolverFault::cpdi_weight)) shape.weight_skew = kFaultyCpdiWeightSkew;
+    if constexpr (requires { shape.shear_sign; }) shape.shear_sign = faults_.shear_sign();
     return shape;
   }
 
@@ -134,6 +135,7 @@ class ExplicitStages : public Stepper {
         return Shape::gradients_beyond_grid_basis;
     }();
     traction_->evaluate(t, traction_force_);
+    faults_.after_traction(traction_force_);
     tractions_to_grid(model_.grid, model_.particles, traction_->edges(), traction_force_,
                       corners ? TractionRule::corners : TractionRule::exact, total, traction_shares_, fields_);
   }
@@ -185,6 +187,7 @@ class ExplicitStages : public Stepper {
       else
         grid_to_particles<Updates, S>(shape, g, model_.particles, dt, kick, position_out, range, &node_motion_);
     });
+    if (settings_.apic) faults_.after_velocity_update(model_.particles);
   }
 
   // F and V alone from the grid velocity (USF, MUSL), the volumes remembered first.
@@ -214,8 +217,12 @@ class ExplicitStages : public Stepper {
       average_cell_dilatation<Shape::geometry>(model_.grid, P, volume_sums_);
     if (settings_.dilatation == Dilatation::node_smoothed)
       smooth_node_dilatation(bind(P), P, volume_sums_, model_.grid.node_count());
+    faults_.before_constitutive_update(P);
     for_each_material([&](const Material& m, std::size_t begin, std::size_t end) {
-      update_stress<Shape::geometry>(m, P, begin, end);
+      if (faults_.is(SolverFault::wrong_shear_modulus))
+        update_stress<Shape::geometry>(with_faulty_shear_modulus(m), P, begin, end);
+      else
+        update_stress<Shape::geometry>(m, P, begin, end);
     });
     faults_.after_constitutive_update(P);
     if (viscosity_.on()) {

@@ -30,6 +30,7 @@ struct CpdiShapeT : CpdiDomainT<G, Form> {
   using Domain::gradient_scale;
   using Domain::corners;
   using Domain::weight_skew;
+  using Domain::shear_sign;
   using Domain::corner_xi;
   using Domain::corner_eta;
   using Domain::Turned;
@@ -205,7 +206,7 @@ struct CpdiShapeT : CpdiDomainT<G, Form> {
     const CpdiLaneGrid lane_grid{g.origin.x(),   g.origin.y(),   g.h,
                                  g.cells_x,      g.cells_y,      g.nodes_x(),    gradient_scale,
                                  weight_skew,    wall_lower.x(), wall_lower.y(),
-                                 wall_upper.x(), wall_upper.y(), for_scan};
+                                 wall_upper.x(), wall_upper.y(), for_scan,       shear_sign};
     if (build) cpdi_lane_stencils(*build, lane_grid, in, batch.out);
     else cpdi_lane_stencils(lane_grid, in, batch.out);
   }

@@ -69,6 +69,10 @@ struct CpdiDomainT {
   // 0, but for a deliberate fault (faults.hpp: cpdi-weight): the corner
   // shares of S_gp are (1/4)(1 + weight_skew xi_c). Parallelogram domains only.
   double weight_skew = 0.0;
+  // 1, but for a deliberate fault (faults.hpp: cpdi-shear-sign): the sign of
+  // the cross terms s10, s01 of s^-T, which only a sheared (or turned)
+  // domain has. Parallelogram domains only.
+  double shear_sign = 1.0;
 
   // s_p = [r_1 r_2], the current domain half-vectors as columns (eq. 1.97);
   // for corner domains the linear part [a_1 a_2] of their map.
@@ -120,6 +124,7 @@ struct CpdiDomainT {
     }
     // s^-T = [[s11, -s10], [-s01, s00]] / det s.
     const double inv_det = gradient_scale / determinant(s);
+    const double s10 = shear_sign * s(1, 0), s01 = shear_sign * s(0, 1);
     double weight_a = 0.0, weight_b = 0.0;
     if constexpr (G == Geometry::axisymmetric) {
       const double weight_r = 1.0 / (3.0 * position[p].x());
@@ -133,8 +138,8 @@ struct CpdiDomainT {
         gxi *= 1.0 + weight_b * eta;
         geta *= 1.0 + weight_a * xi;
       }
-      gx[c] = inv_det * (s(1, 1) * gxi - s(1, 0) * geta);
-      gy[c] = inv_det * (s(0, 0) * geta - s(0, 1) * gxi);
+      gx[c] = inv_det * (s(1, 1) * gxi - s10 * geta);
+      gy[c] = inv_det * (s(0, 0) * geta - s01 * gxi);
     }
   }
 

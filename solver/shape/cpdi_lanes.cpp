@@ -11,6 +11,10 @@ namespace {
 
 using namespace lanes::MPMVV_LANE_BUILD_NS;
 
+// FlipShear: the cpdi-shear-sign fault (faults.hpp), a kernel of its own so
+// that a real run's kernel holds no trace of it (chosen once per batch list:
+// cpdi_lane_stencils).
+template <bool FlipShear>
 struct CpdiKernel {
   using Grid = CpdiLaneGrid;
   using In = CpdiLaneInput;
@@ -29,8 +33,9 @@ MPMVV_LANE_INLINE Lanes octagon_length(const Lanes& gx, const Lanes& gy) {
 }
 
 // Lanes l0, ..., l0 + W - 1.
+template <bool FlipShear>
 template <int W>
-void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneStencils& out, int l0) {
+void CpdiKernel<FlipShear>::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneStencils& out, int l0) {
   using Lanes = typename Width<W>::Lanes;
   using Mask = typename Width<W>::Mask;
   using Ints = typename Width<W>::Ints;
@@ -71,8 +76,10 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
     const double xi = kCornerXi[c], eta = kCornerEta[c];
     corner_weight[c] = 0.25 * (1.0 + g.weight_skew * xi);
     const double gxi = 0.25 * xi, geta = 0.25 * eta;
-    grad_x[c] = inv_det * (s11 * gxi - s10 * geta);
-    grad_y[c] = inv_det * (s00 * geta - s01 * gxi);
+    // The cross terms' factors (their sign flipped by cpdi-shear-sign).
+    const double cross_xi = FlipShear ? -gxi : gxi, cross_eta = FlipShear ? -geta : geta;
+    grad_x[c] = inv_det * (s11 * gxi - s10 * cross_eta);
+    grad_y[c] = inv_det * (s00 * geta - s01 * cross_xi);
     // The corner x_p + xi r_1 + eta r_2 in grid coordinates, its cell and
     // its place in the cell.
     const Lanes cx = (x + xi * s00 + eta * s01 - g.origin_x) / g.h;
@@ -208,7 +215,8 @@ void CpdiKernel::body(const CpdiLaneGrid& g, const CpdiLaneInput& in, CpdiLaneSt
 
 namespace lanes::MPMVV_LANE_BUILD_NS {
 void cpdi_lane_stencils(const CpdiLaneGrid& grid, const CpdiLaneInput& in, CpdiLaneStencils& out) {
-  run<CpdiKernel>(grid, in, out);
+  if (grid.shear_sign < 0.0) run<CpdiKernel<true>>(grid, in, out);
+  else run<CpdiKernel<false>>(grid, in, out);
 }
 }  // namespace lanes::MPMVV_LANE_BUILD_NS
 

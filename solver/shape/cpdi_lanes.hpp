@@ -37,6 +37,7 @@ struct CpdiLaneGrid {
   double wall_lower_x, wall_lower_y, wall_upper_x, wall_upper_y;  // GridGeometry::wall_lower, wall_upper
   bool for_scan;               // the time-step scan reads the batch: fill inside (four divisions
                                // a lane) and gradient_bound, else -1 there
+  double shear_sign = 1.0;     // CpdiShapeT::shear_sign
 };
 
 // Eight particles' centres x_p and domains s_p = [r_1 r_2] = F_p diag(l_p)

@@ -82,10 +82,11 @@ struct GimpShapeT {
   const GridGeometry* grid;
   const Vec2* position;
   const Vec2* half_size;
+  double gradient_scale = 1.0;  // 1, but for a deliberate fault (faults.hpp: gimp-gradient)
 
   static GimpShapeT bind(const GridGeometry& grid, const Particles& particles, const Mat2* = nullptr,
-                       double = 1.0) {
-    return {&grid, particles.position.data(), particles.half_size.data()};
+                       double gradient_scale = 1.0) {
+    return {&grid, particles.position.data(), particles.half_size.data(), gradient_scale};
   }
 
   // With l_p <= h/2 a particle reaches the node nearest to it and one on each
@@ -109,16 +110,16 @@ struct GimpShapeT {
       if constexpr (G == Geometry::axisymmetric) {
         const GimpRadial1D r = gimp_radial_1d(x.x(), node_x, g.h, half_size[p].x());
         wx[a] = in_x ? r.weight : 0.0;
-        dx[a] = in_x ? r.derivative : 0.0;
+        dx[a] = in_x ? gradient_scale * r.derivative : 0.0;
         hx[a] = in_x ? r.hoop : 0.0;
       } else {
         const GimpWeight1D w = gimp_weight_1d(x.x() - node_x, g.h, half_size[p].x());
         wx[a] = in_x ? w.weight : 0.0;
-        dx[a] = in_x ? w.derivative : 0.0;
+        dx[a] = in_x ? gradient_scale * w.derivative : 0.0;
       }
       const GimpWeight1D w = gimp_weight_1d((xi.y() - j) * g.h, g.h, half_size[p].y());
       wy[a] = in_y ? w.weight : 0.0;
-      dy[a] = in_y ? w.derivative : 0.0;
+      dy[a] = in_y ? gradient_scale * w.derivative : 0.0;
     }
     int k = 0;
     for (int b = 0; b < 3; ++b) {
@@ -163,7 +164,8 @@ struct GimpShapeT {
     const Vec2 wall_lower = g.wall_lower(), wall_upper = g.wall_upper(), upper = g.upper();
     const GimpLaneGrid lane_grid{g.origin.x(),   g.origin.y(),   g.h,            g.cells_x,
                                  g.cells_y,      g.nodes_x(),    wall_lower.x(), wall_lower.y(),
-                                 wall_upper.x(), wall_upper.y(), upper.x(),      upper.y()};
+                                 wall_upper.x(), wall_upper.y(), upper.x(),      upper.y(),
+                                 gradient_scale};
     if (build) gimp_lane_stencils(*build, lane_grid, in, batch.out);
     else gimp_lane_stencils(lane_grid, in, batch.out);
   }

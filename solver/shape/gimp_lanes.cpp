@@ -40,6 +40,10 @@ MPMVV_LANE_INLINE void gimp_1d(const Lanes& d, double h, const Lanes& l, Lanes& 
   dw = outside ? zero : b / r;
 }
 
+// Scaled: the gimp-gradient fault (faults.hpp), a kernel of its own so that
+// a real run's kernel holds no trace of it (chosen once per batch list:
+// gimp_lane_stencils).
+template <bool Scaled>
 struct GimpKernel {
   using Grid = GimpLaneGrid;
   using In = GimpLaneInput;
@@ -50,8 +54,9 @@ struct GimpKernel {
 };
 
 // Lanes l0, ..., l0 + W - 1.
+template <bool Scaled>
 template <int W>
-void GimpKernel::body(const GimpLaneGrid& g, const GimpLaneInput& in, GimpLaneStencils& out, int l0) {
+void GimpKernel<Scaled>::body(const GimpLaneGrid& g, const GimpLaneInput& in, GimpLaneStencils& out, int l0) {
   using Lanes = typename Width<W>::Lanes;
   using Mask = typename Width<W>::Mask;
   using Ints = typename Width<W>::Ints;
@@ -76,6 +81,7 @@ void GimpKernel::body(const GimpLaneGrid& g, const GimpLaneInput& in, GimpLaneSt
   const Ints last_i = none + g.cells_x, last_j = none + g.cells_y;
   Lanes wx[3], dx[3], wy[3], dy[3];
   Ints node_i[3], node_j[3];
+  const double gradient_scale = Scaled ? g.gradient_scale : 1.0;  // a local: g is read again after every store
   for (int a = 0; a < 3; ++a) {
     const Ints i = i0 + a, j = j0 + a;
     const Mask in_x = to_mask<Mask>((i >= none) & (i <= last_i));
@@ -88,10 +94,10 @@ void GimpKernel::body(const GimpLaneGrid& g, const GimpLaneInput& in, GimpLaneSt
     Lanes w, dw;
     gimp_1d<Lanes, Mask>(x - node_x, g.h, lx, w, dw);
     wx[a] = in_x ? w : zero;
-    dx[a] = in_x ? dw : zero;
+    dx[a] = in_x ? (Scaled ? gradient_scale * dw : dw) : zero;
     gimp_1d<Lanes, Mask>((xi_y - to_doubles<Lanes>(j)) * g.h, g.h, ly, w, dw);
     wy[a] = in_y ? w : zero;
-    dy[a] = in_y ? dw : zero;
+    dy[a] = in_y ? (Scaled ? gradient_scale * dw : dw) : zero;
   }
   const Ints block = (node_i[2] == node_i[0] + 2) & (node_j[2] == node_j[0] + 2);
   store(out.block_first + l0, block ? node_i[0] + node_j[0] * g.nodes_x : none - 1);
@@ -107,7 +113,8 @@ void GimpKernel::body(const GimpLaneGrid& g, const GimpLaneInput& in, GimpLaneSt
 
 namespace lanes::MPMVV_LANE_BUILD_NS {
 void gimp_lane_stencils(const GimpLaneGrid& grid, const GimpLaneInput& in, GimpLaneStencils& out) {
-  run<GimpKernel>(grid, in, out);
+  if (grid.gradient_scale != 1.0) run<GimpKernel<true>>(grid, in, out);
+  else run<GimpKernel<false>>(grid, in, out);
 }
 }  // namespace lanes::MPMVV_LANE_BUILD_NS
 

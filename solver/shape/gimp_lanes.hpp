@@ -16,6 +16,7 @@ struct GimpLaneGrid {
   int nodes_x;           // GridGeometry::nodes_x, for block_first
   double wall_lower_x, wall_lower_y, wall_upper_x, wall_upper_y;  // GridGeometry::wall_lower, wall_upper
   double upper_x, upper_y;                                        // GridGeometry::upper
+  double gradient_scale = 1.0;                                    // GimpShapeT::gradient_scale
 };
 
 // Eight particles' centres x_p and half-sizes l_p, read in place: the

@@ -17,13 +17,15 @@ namespace mpmvv {
 
 // Bilinear hat weights and gradients of the four nodes of the cell holding x
 // (x inside the grid). Shared by linear MPM and by massless tracers.
-inline void bilinear_cell(const GridGeometry& grid, const Vec2& x, int* node, double* weight, Vec2* gradient) {
+// `gradient_scale` is 1 but for a deliberate fault (faults.hpp: linear-gradient).
+inline void bilinear_cell(const GridGeometry& grid, const Vec2& x, int* node, double* weight, Vec2* gradient,
+                          double gradient_scale = 1.0) {
   const Vec2 xi = grid_coordinate(grid, x);
   const int i = cell_index(xi.x(), grid.cells_x);
   const int j = cell_index(xi.y(), grid.cells_y);
   const double fx = xi.x() - i, fy = xi.y() - j;  // in [0, 1]
   const double gx = 1.0 - fx, gy = 1.0 - fy;
-  const double inv_h = 1.0 / grid.h;
+  const double inv_h = gradient_scale / grid.h;
   const int n00 = grid.node(i, j);
   node[0] = n00;
   node[1] = n00 + 1;
@@ -74,14 +76,15 @@ struct LinearShapeT {
 
   const GridGeometry* grid;
   const Vec2* position;
+  double gradient_scale = 1.0;  // 1, but for a deliberate fault (faults.hpp: linear-gradient)
 
   static LinearShapeT bind(const GridGeometry& grid, const Particles& particles, const Mat2* = nullptr,
-                       double = 1.0) {
-    return {&grid, particles.position.data()};
+                       double gradient_scale = 1.0) {
+    return {&grid, particles.position.data(), gradient_scale};
   }
 
   void evaluate(std::size_t p, Stencil<stencil_size>& s) const {
-    bilinear_cell(*grid, position[p], s.node, s.weight, s.gradient);
+    bilinear_cell(*grid, position[p], s.node, s.weight, s.gradient, gradient_scale);
     if constexpr (G == Geometry::axisymmetric) {
       const double inv_r = 1.0 / position[p].x();
       for (int k = 0; k < stencil_size; ++k) s.hoop[k] = s.weight[k] * inv_r;
@@ -122,7 +125,8 @@ struct LinearShapeT {
     batch.first = first;
     const Vec2 wall_lower = g.wall_lower(), wall_upper = g.wall_upper();
     const LinearLaneGrid lane_grid{g.origin.x(),   g.origin.y(),   g.h,            g.cells_x,     g.cells_y,
-                                   g.nodes_x(),    wall_lower.x(), wall_lower.y(), wall_upper.x(), wall_upper.y()};
+                                   g.nodes_x(),    wall_lower.x(), wall_lower.y(), wall_upper.x(), wall_upper.y(),
+                                   gradient_scale};
     linear_lane_stencils(build ? *build : lane_build(), lane_grid, in, batch.out);
   }
 

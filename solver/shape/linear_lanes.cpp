@@ -35,7 +35,7 @@ struct LinearKernel {
     store(out.first_node + l0, j * g.nodes_x + i);  // GridGeometry::node(i, j)
     const Lanes fx = xi_x - to_doubles<Lanes>(i), fy = xi_y - to_doubles<Lanes>(j);
     const Lanes gx = 1.0 - fx, gy = 1.0 - fy;
-    const double inv_h = 1.0 / g.h;
+    const double inv_h = g.gradient_scale / g.h;
     // Slots 0, 1, 3, 4: bilinear_cell's entries 0-3, each stored as it is
     // formed (arrays of them were copied through the stack).
     store(out.weight[0] + l0, gx * gy);

@@ -18,6 +18,7 @@ struct LinearLaneGrid {
   int cells_x, cells_y;  // ghost layers included
   int nodes_x;
   double wall_lower_x, wall_lower_y, wall_upper_x, wall_upper_y;  // GridGeometry::wall_lower, wall_upper
+  double gradient_scale = 1.0;  // LinearShapeT::gradient_scale
 };
 
 // Eight particles' positions x_p, read in place from the batch's first, or

@@ -47,11 +47,23 @@ inline void grid_velocity_from_momentum(GridFields& g) {
 // x-walls are mirrored first over all rows, then the y-walls over all columns,
 // so corner ghosts mirror in both. `swapped` is a deliberate fault
 // (faults.hpp: swapped-walls): each wall treats the tangential component as
-// its normal one.
-inline void apply_walls(const GridGeometry& grid, GridFields& g, bool swapped = false) {
+// its normal one; `mirrored` another (mirrored-wall): a wall node's normal
+// components are reflected, -v_n, instead of set to zero.
+inline void apply_walls(const GridGeometry& grid, GridFields& g, bool swapped = false, bool mirrored = false) {
   const int nx = grid.nodes_x(), ny = grid.nodes_y(), ghost = grid.ghost_layers;
   const int x_walls[2] = {ghost, nx - 1 - ghost}, y_walls[2] = {ghost, ny - 1 - ghost};
   const int x_normal = swapped ? 1 : 0, y_normal = 1 - x_normal;
+  // A wall node's normal velocity and acceleration: zero, or under
+  // mirrored-wall reflected.
+  auto on_wall = [&g, mirrored](int node, int normal) {
+    if (mirrored) {
+      g.velocity[node][normal] = -g.velocity[node][normal];
+      g.acceleration[node][normal] = -g.acceleration[node][normal];
+    } else {
+      g.velocity[node][normal] = 0.0;
+      g.acceleration[node][normal] = 0.0;
+    }
+  };
   auto mirror = [&g](int from, int to, int normal) {
     g.velocity[to] = g.velocity[from];
     g.acceleration[to] = g.acceleration[from];
@@ -59,20 +71,14 @@ inline void apply_walls(const GridGeometry& grid, GridFields& g, bool swapped = 
     g.acceleration[to][normal] = -g.acceleration[from][normal];
   };
   for (int j = 0; j < ny; ++j) {
-    for (int w : x_walls) {
-      g.velocity[grid.node(w, j)][x_normal] = 0.0;
-      g.acceleration[grid.node(w, j)][x_normal] = 0.0;
-    }
+    for (int w : x_walls) on_wall(grid.node(w, j), x_normal);
     for (int k = 1; k <= ghost; ++k) {
       mirror(grid.node(x_walls[0] + k, j), grid.node(x_walls[0] - k, j), x_normal);
       mirror(grid.node(x_walls[1] - k, j), grid.node(x_walls[1] + k, j), x_normal);
     }
   }
   for (int i = 0; i < nx; ++i) {
-    for (int w : y_walls) {
-      g.velocity[grid.node(i, w)][y_normal] = 0.0;
-      g.acceleration[grid.node(i, w)][y_normal] = 0.0;
-    }
+    for (int w : y_walls) on_wall(grid.node(i, w), y_normal);
     for (int k = 1; k <= ghost; ++k) {
       mirror(grid.node(i, y_walls[0] + k), grid.node(i, y_walls[0] - k), y_normal);
       mirror(grid.node(i, y_walls[1] - k), grid.node(i, y_walls[1] + k), y_normal);

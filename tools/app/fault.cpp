@@ -14,6 +14,7 @@ const char* kind_name(Fault::Kind k) {
   switch (k) {
     case Fault::none: return "";
     case Fault::no_body_force: return "no-body-force";
+    case Fault::exact_seeding_volume: return "exact-seeding-volume";
     case Fault::crash: return "crash";
     case Fault::hang: return "hang";
     case Fault::solver: return "solver";
@@ -31,12 +32,12 @@ Fault injected_fault(const std::string& results_path) {
   const char* value = std::getenv("MPMVV_FAULT");
   if (!value || !*value) return {};
   Fault f;
-  for (Fault::Kind k : {Fault::no_body_force, Fault::crash, Fault::hang})
+  for (Fault::Kind k : {Fault::no_body_force, Fault::exact_seeding_volume, Fault::crash, Fault::hang})
     if (std::string(value) == kind_name(k)) f.kind = k;
   if (f.kind == Fault::none) {
     f.in_solver = solver_fault_named(value);
     if (f.in_solver == SolverFault::none) {
-      std::string names = "no-body-force, crash, hang";
+      std::string names = "no-body-force, exact-seeding-volume, crash, hang";
       for (SolverFault s : kSolverFaults) names += fmt::format(", {}", mpmvv::to_string(s));
       throw ConfigError(fmt::format("MPMVV_FAULT={}: unknown fault ({})", value, names));
     }

@@ -72,7 +72,7 @@ class Case final : public SceneCase, private RunObserver {
         options_.method == Method::cpdi_exact && options_.cpdi_domain != CpdiDomain::corners && exact_seeding_;
     seeded_ = seed_particles(setup_,
                              {int(config_.integer("particles_per_direction")), exact_seeding_,
-                              options_.method != Method::linear, outlines},
+                              options_.method != Method::linear, outlines, fault_ == Fault::exact_seeding_volume},
                              model.particles);
     if (model.particles.size() == 0)
       throw ConfigError(fmt::format("the body holds no particle centre at cells = {}: use more cells",
@@ -92,8 +92,7 @@ class Case final : public SceneCase, private RunObserver {
     }
     if (implicit()) {
 #ifdef MPMVV_HAVE_SUNDIALS
-      const double ramp = std::isfinite(setup_.smooth_until) ? setup_.smooth_until : loop_.end_time;
-      loop_.fixed_step = ramp / double(config_.integer("load_steps"));
+      loop_.fixed_step = load_step();
       StaticOptions static_options;
       static_options.tolerance = config_.real("newton_tolerance");
       stepper_ = make_static_stepper(std::move(model), options_, setup_.material, std::move(stages), static_options);
@@ -142,6 +141,11 @@ class Case final : public SceneCase, private RunObserver {
   }
 
   bool implicit() const { return config_.has("solver") && config_.text("solver") == "implicit"; }
+  // An implicit run's step: the load's ramp (to smooth_until, or the end) in load_steps.
+  double load_step() const {
+    const double ramp = std::isfinite(setup_.smooth_until) ? setup_.smooth_until : loop_.end_time;
+    return ramp / double(config_.integer("load_steps"));
+  }
 
   mms::ForceQuadrature force_quadrature() const {
     return config_.has("body_force_quadrature") && config_.text("body_force_quadrature") == "domain"
@@ -195,7 +199,9 @@ class Case final : public SceneCase, private RunObserver {
     // A fixed step (an implicit run's load steps) counts itself; the CFL
     // step is taken at rest.
     const double c0 = std::sqrt(p_wave_modulus(setup_.material) / config_.real("density"));
-    const double dt = loop_.fixed_step > 0.0 ? loop_.fixed_step : loop_.cfl * g.h / c0;
+    const double dt = implicit()               ? load_step()
+                      : loop_.fixed_step > 0.0 ? loop_.fixed_step
+                                               : loop_.cfl * g.h / c0;
     w.steps = (long long)std::ceil(loop_.end_time / dt - 1e-9);
     w.implicit = implicit();
     return w;

@@ -53,7 +53,10 @@ std::vector<Piece> pieces_of_cell(const SceneSetup& setup, const SeedingPlan& pl
         if (body.boundary_may_meet(lower, lower + spacing * Vec2(1.0, 1.0))) {
           const AreaMoments m = body.clip(lower, lower + spacing * Vec2(1.0, 1.0));
           if (m.area > 1e-14 * spacing * spacing) {
-            pieces.push_back({m.centroid(), m.area, m.moment_x, {}});
+            if (plan.whole_cut_volume)
+              pieces.push_back({m.centroid(), whole.area, whole.area * m.centroid().x(), {}});
+            else
+              pieces.push_back({m.centroid(), m.area, m.moment_x, {}});
             if (plan.outlines) pieces.back().outline = body.clip_outline(lower, lower + spacing * Vec2(1.0, 1.0),
                                                                        0.25 * spacing);
           }

@@ -16,6 +16,10 @@ struct SeedingPlan {
   bool exact;       // seeding = "exact": clipped pieces of the CGAL body; else sub-cell centres in the body
   bool half_sizes;  // a method with particle domains (all but linear): each particle's half-size
   bool outlines;    // exact CPDI with exact seeding: each clipped piece's outline as its domain
+  // A deliberate fault (tools/app/fault.hpp: exact-seeding-volume): a piece
+  // the boundary cuts keeps the whole sub-cell's area (and its r-moment in
+  // r-z) as its volume, not the part inside the body.
+  bool whole_cut_volume = false;
 };
 
 struct Seeded {
