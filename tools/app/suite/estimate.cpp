@@ -49,6 +49,8 @@ struct Work {
 // and its particles.
 struct Calibration {
   double step_factor = 1.0;
+  double particle_factor = 1.0;     // particles stepped over the particles seeded (split domains add some)
+  double seconds_per_work = 0.0;    // wall time over the work at rest (particles seeded x steps at rest)
   double rate = 0.0;
   double seconds_per_step = 0.0;
   std::size_t particles = 0;
@@ -62,6 +64,9 @@ Calibration calibrate(const WorkEstimate& w, long long steps, long long particle
   Calibration k;
   const double share = end_time > 0.0 ? std::clamp(reached / end_time, 1e-9, 1.0) : 1.0;
   k.step_factor = w.steps > 0 && steps > 0 ? double(steps) / (double(w.steps) * share) : 1.0;
+  k.particle_factor = steps > 0 && w.particles > 0 ? double(particle_steps) / (double(steps) * double(w.particles)) : 1.0;
+  const double work = double(w.particles) * double(w.steps) * share;
+  k.seconds_per_work = work > 0.0 ? wall / work : 0.0;
   k.rate = wall > 0.0 ? double(particle_steps) / wall : 0.0;
   k.seconds_per_step = steps > 0 ? wall / double(steps) : 0.0;
   k.particles = w.particles;
@@ -202,10 +207,12 @@ std::vector<PlannedCase> plan_cases(const Suite& suite, const std::function<bool
       e.basis = fmt::format("{:.3g} s a load step at {} particles ({})", cal->seconds_per_step, cal->particles,
                             cal->basis);
     } else {
+      // The calibration's wall time per unit of work at rest: its steps'
+      // growth, its particles' (split domains) and its rate in one.
       e.steps = (long long)std::llround(double(k.w->steps) * cal->step_factor);
-      e.seconds = double(k.w->particles) * double(*e.steps) / cal->rate;
-      e.basis = fmt::format("{:.2f} x the steps at rest, {:.3g} M particle-steps/s ({})", cal->step_factor,
-                            cal->rate * 1e-6, cal->basis);
+      e.seconds = double(k.w->particles) * double(k.w->steps) * cal->seconds_per_work;
+      e.basis = fmt::format("{:.2f} x the steps at rest, {:.2f} x the particles seeded, {:.3g} M particle-steps/s ({})",
+                            cal->step_factor, cal->particle_factor, cal->rate * 1e-6, cal->basis);
     }
     double& slot = *std::min_element(slots.begin(), slots.end());
     p.start = slot;

@@ -9,9 +9,9 @@
 //   - its cheapest case run now, stopped after kProbeSeconds of wall time
 //     (a run stopped early is extrapolated from the share of its end time it
 //     reached, which the basis column says).
-// A case then takes its own particles x steps at rest x (the calibration's
-// steps over its steps at rest) over the calibration's particle-steps per
-// second; an implicit case (load steps, each a Newton solve) the
+// A case then takes its own particles x steps at rest x the calibration's
+// wall time per particle-step at rest (which holds its steps' growth, its
+// particles' growth where domains split, and its rate); an implicit case (load steps, each a Newton solve) the
 // calibration's wall time per load step x (particles over the calibration's)
 // to the power 1.5.
 #pragma once
