@@ -428,3 +428,43 @@ TEST(SuiteRunner, CasesEndWithTheirSuite) {
   ::pclose(pipe);
   EXPECT_EQ(said, "started\ngone\n");
 }
+
+// --list estimates each case before anything runs: in a fresh directory
+// from the cheapest case of each study run now (for at most a few seconds),
+// with the total and the cases a budget leaves out; once the suite has run,
+// each case is done and the budget holds. A suite without a ci tier is
+// refused for it.
+TEST(SuiteRunner, ListEstimatesEachCaseAndTheBudget) {
+  const fs::path dir = scratch("estimate");
+  const fs::path suite = write(dir / "s.toml", small_suite());
+  const std::string list = std::string(MPMVV_BINARY) + " suite " + suite.string() + " -j 1 -t 1 --list --budget 1e-6 -o " +
+                           (dir / "out").string() + " > " + (dir / "list.txt").string() + " 2>&1";
+  ASSERT_EQ(std::system(list.c_str()), 0) << read(dir / "list.txt");
+  std::string text = read(dir / "list.txt");
+  for (const char* id : {"square-cells=8 ", "square-cells=12 ", "square-cells=16 "}) {
+    const auto at = text.find(std::string("\n") + id);
+    ASSERT_NE(at, std::string::npos) << id << "\n" << text;
+    const std::string line = text.substr(at + 1, text.find('\n', at + 1) - at - 1);
+    EXPECT_NE(line.find("M particle-steps/s (square-cells=8 run now)"), std::string::npos) << line;
+    EXPECT_EQ(line.find(" - "), std::string::npos) << "not estimated: " << line;
+  }
+  EXPECT_NE(text.find("estimating: running square-cells=8"), std::string::npos) << text;
+  EXPECT_NE(text.find("3 cases would not end within it: square-cells=8, square-cells=12, square-cells=16"),
+            std::string::npos)
+      << text;
+  EXPECT_FALSE(fs::exists(dir / "out" / "manifest.json")) << "--list ran the suite";
+
+  ASSERT_EQ(shell(std::string(MPMVV_BINARY) + " suite " + suite.string() + " -j 2 -q -o " + (dir / "out").string()), 0);
+  ASSERT_EQ(std::system(list.c_str()), 0) << read(dir / "list.txt");
+  text = read(dir / "list.txt");
+  EXPECT_EQ(count(text, "done: completed in"), 3) << text;
+  EXPECT_EQ(text.find("estimating: running"), std::string::npos) << text;
+  EXPECT_NE(text.find("every estimated case ends within it"), std::string::npos) << text;
+
+  const std::string ci = std::string(MPMVV_BINARY) + " suite " + suite.string() + " --tier ci --list > " +
+                         (dir / "ci.txt").string() + " 2>&1";
+  const int status = std::system(ci.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 2);
+  EXPECT_NE(read(dir / "ci.txt").find("no study has a ci tier"), std::string::npos) << read(dir / "ci.txt");
+}
