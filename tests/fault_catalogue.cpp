@@ -28,6 +28,52 @@ namespace {
 
 using namespace mpmvv::suite_testing;
 
+// The gate on `suite` run under MPMVV_FAULT=`fault` with `arguments` (its
+// tier, jobs, --only) into `dir`/out: the gate's exit status and table, and
+// the expectations ('#') with a FAIL row from runs (`failed`) and with one
+// for want of runs (`pending`: a case --only left out).
+struct GateUnderFault {
+  int status = -1;
+  std::string table;
+  std::vector<int> failed, pending;
+};
+
+GateUnderFault gate_under_fault(const std::string& fault, const std::string& suite, const std::string& arguments,
+                                const fs::path& dir) {
+  GateUnderFault g;
+  const int ran = shell("MPMVV_FAULT=" + fault + " " + MPMVV_BINARY + " suite " + suite + " " + arguments + " -q -o " +
+                        (dir / "out").string());
+  if (ran != 0 && ran != 1) {
+    g.table = "the suite itself must run (exit " + std::to_string(ran) + ")";
+    return g;
+  }
+  const fs::path table = dir / "gate.txt";
+  const int gated = std::system((std::string(MPMVV_BINARY) + " gate " + (dir / "out").string() + " > " +
+                                 table.string() + " 2>&1").c_str());
+  g.status = WIFEXITED(gated) ? WEXITSTATUS(gated) : -1;
+  g.table = read(table);
+  std::istringstream lines(g.table);
+  for (std::string line; std::getline(lines, line);) {
+    std::smatch m;
+    if (!std::regex_search(line, m, std::regex("^(\\d+) ")) || line.find(" FAIL ") == std::string::npos) continue;
+    (line.find("pending") == std::string::npos ? g.failed : g.pending).push_back(std::stoi(m[1].str()));
+  }
+  return g;
+}
+
+bool holds(const std::vector<int>& numbers, int number) {
+  return std::find(numbers.begin(), numbers.end(), number) != numbers.end();
+}
+
+// A parameterised test's name: its fault, '-' as '_'.
+template <class Caught>
+std::string fault_name(const ::testing::TestParamInfo<Caught>& info) {
+  std::string name = info.param.fault;
+  for (char& c : name)
+    if (c == '-') c = '_';
+  return name;
+}
+
 struct CaughtByTheQuickGate {
   const char* fault;
   const char* studies;             // --only: the quick suite's studies that catch it
@@ -53,42 +99,22 @@ const CaughtByTheQuickGate kQuickGateCatalogue[] = {
     {"cpdi-weight", "^uniaxial-cpdi-", {12}},
 };
 
-std::string name_of(const ::testing::TestParamInfo<CaughtByTheQuickGate>& info) {
-  std::string name = info.param.fault;
-  for (char& c : name)
-    if (c == '-') c = '_';
-  return name;
-}
-
 class QuickGate : public ::testing::TestWithParam<CaughtByTheQuickGate> {};
 
-INSTANTIATE_TEST_SUITE_P(FaultCatalogue, QuickGate, ::testing::ValuesIn(kQuickGateCatalogue), name_of);
+INSTANTIATE_TEST_SUITE_P(FaultCatalogue, QuickGate, ::testing::ValuesIn(kQuickGateCatalogue),
+                         fault_name<CaughtByTheQuickGate>);
 
 TEST_P(QuickGate, CatchesTheFault) {
   const CaughtByTheQuickGate& c = GetParam();
-  const fs::path dir = scratch(std::string("fault-") + c.fault);
-  const std::string suite = std::string(MPMVV_SOURCE_DIR) + "/suites/ring-quick.toml";
-  const int ran = shell(std::string("MPMVV_FAULT=") + c.fault + " " + MPMVV_BINARY + " suite " + suite +
-                        " -j 2 -q --only '" + c.studies + "' -o " + (dir / "out").string());
-  ASSERT_TRUE(ran == 0 || ran == 1) << "the suite itself must run (exit " << ran << ")";
-  const fs::path table = dir / "gate.txt";
-  const int gated = std::system((std::string(MPMVV_BINARY) + " gate " + (dir / "out").string() + " > " +
-                                 table.string() + " 2>&1").c_str());
-  ASSERT_TRUE(WIFEXITED(gated));
-  EXPECT_EQ(WEXITSTATUS(gated), 1) << read(table);
+  const GateUnderFault g = gate_under_fault(c.fault, std::string(MPMVV_SOURCE_DIR) + "/suites/ring-quick.toml",
+                                            std::string("-j 2 --only '") + c.studies + "'",
+                                            scratch(std::string("fault-") + c.fault));
+  EXPECT_EQ(g.status, 1) << g.table;
   // Each listed expectation's rows: FAIL, for a reason its runs give.
-  std::istringstream lines(read(table));
-  std::vector<int> failed, pending;
-  for (std::string line; std::getline(lines, line);) {
-    std::smatch m;
-    if (!std::regex_search(line, m, std::regex("^(\\d+) ")) || line.find(" FAIL ") == std::string::npos) continue;
-    (line.find("pending") == std::string::npos ? failed : pending).push_back(std::stoi(m[1].str()));
-  }
   for (int number : c.expectations) {
-    EXPECT_NE(std::find(failed.begin(), failed.end(), number), failed.end())
-        << "expectation " << number << " does not fail under " << c.fault << ":\n" << read(table);
-    EXPECT_EQ(std::find(pending.begin(), pending.end(), number), pending.end())
-        << "expectation " << number << " lacks runs:\n" << read(table);
+    EXPECT_TRUE(holds(g.failed, number)) << "expectation " << number << " does not fail under " << c.fault << ":\n"
+                                         << g.table;
+    EXPECT_FALSE(holds(g.pending, number)) << "expectation " << number << " lacks runs:\n" << g.table;
   }
 }
 
@@ -143,42 +169,23 @@ const CaughtByACiTier kCiTierCatalogue[] = {
     {"gimp-gradient", "ring-quick", "^ring-method=gimp-", {1}},
 };
 
-std::string ci_name_of(const ::testing::TestParamInfo<CaughtByACiTier>& info) {
-  std::string name = info.param.fault;
-  for (char& c : name)
-    if (c == '-') c = '_';
-  return name;
-}
-
 class CiTierGate : public ::testing::TestWithParam<CaughtByACiTier> {};
 
-INSTANTIATE_TEST_SUITE_P(FaultCatalogue, CiTierGate, ::testing::ValuesIn(kCiTierCatalogue), ci_name_of);
+INSTANTIATE_TEST_SUITE_P(FaultCatalogue, CiTierGate, ::testing::ValuesIn(kCiTierCatalogue), fault_name<CaughtByACiTier>);
 
 TEST_P(CiTierGate, CatchesTheFault) {
   const CaughtByACiTier& c = GetParam();
-  const fs::path dir = scratch(std::string("ci-fault-") + c.fault);
-  const std::string suite = std::string(MPMVV_SOURCE_DIR) + "/suites/" + c.suite + ".toml";
-  const int ran = shell(std::string("MPMVV_FAULT=") + c.fault + " " + MPMVV_BINARY + " suite " + suite +
-                        " --tier ci -j 1 -t 1 -q --only '" + c.studies + "' -o " + (dir / "out").string());
-  ASSERT_TRUE(ran == 0 || ran == 1) << "the suite itself must run (exit " << ran << ")";
-  const fs::path table = dir / "gate.txt";
-  const int gated = std::system((std::string(MPMVV_BINARY) + " gate " + (dir / "out").string() + " > " +
-                                 table.string() + " 2>&1").c_str());
-  ASSERT_TRUE(WIFEXITED(gated));
-  EXPECT_EQ(WEXITSTATUS(gated), 1) << read(table);
-  std::istringstream lines(read(table));
-  std::vector<int> failed;
-  for (std::string line; std::getline(lines, line);) {
-    std::smatch m;
-    if (!std::regex_search(line, m, std::regex("^(\\d+) ")) || line.find(" FAIL ") == std::string::npos) continue;
-    if (line.find("pending") == std::string::npos) failed.push_back(std::stoi(m[1].str()));
-  }
+  const GateUnderFault g =
+      gate_under_fault(c.fault, std::string(MPMVV_SOURCE_DIR) + "/suites/" + c.suite + ".toml",
+                       std::string("--tier ci -j 1 -t 1 --only '") + c.studies + "'",
+                       scratch(std::string("ci-fault-") + c.fault));
+  EXPECT_EQ(g.status, 1) << g.table;
   // (A row of a series --only left out is pending; the listed expectation
   // needs a row that fails on its runs.)
   for (int number : c.expectations)
-    EXPECT_NE(std::find(failed.begin(), failed.end(), number), failed.end())
-        << "expectation " << number << " of " << c.suite << " does not fail on its runs under " << c.fault << ":\n"
-        << read(table);
+    EXPECT_TRUE(holds(g.failed, number)) << "expectation " << number << " of " << c.suite
+                                         << " does not fail on its runs under " << c.fault << ":\n"
+                                         << g.table;
 }
 
 // lagged-stress holds the stress of the update before; a split (split.hpp)

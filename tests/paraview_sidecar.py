@@ -9,7 +9,6 @@ where ParaView's Python is not installed (it is not a dependency:
 
     /usr/bin/python3 tests/paraview_sidecar.py MPMVV
 """
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -23,8 +22,9 @@ except ImportError:
 import h5py
 import numpy as np
 
+from sidecar_runs import TIMES, sidecar_runs
+
 MPMVV = sys.argv[1]
-SOURCE = Path(__file__).resolve().parents[1]
 failures = []
 
 
@@ -50,21 +50,14 @@ def points_at(reader, time):
 
 with tempfile.TemporaryDirectory() as tmp:
     tmp = Path(tmp)
-    times = [0.05, 0.1, 0.15, 0.2]
-    for name, extra in (("series", ["--set", "particle_fields=outputs"]), ("end", [])):
-        out = tmp / f"{name}.h5"
-        ran = subprocess.run([MPMVV, "run", SOURCE / "suites" / "scenes" / "ring.toml", "--set", "cells=32",
-                              "--set", "end_time=0.2", "--set", f"output_times=[{','.join(map(str, times))}]",
-                              *extra, "--threads", "1", "--quiet", "-o", out], capture_output=True, text=True)
-        if ran.returncode != 0 or not out.with_suffix(".xmf").is_file():
-            sys.exit(f"mpmvv run {name}: exit {ran.returncode}, {ran.stderr}")
+    for name, out in sidecar_runs(MPMVV, tmp):
         reader = OpenDataFile(str(out.with_suffix(".xmf").resolve()))
         steps = list(reader.TimestepValues) if hasattr(reader.TimestepValues, "__len__") else [reader.TimestepValues]
         with h5py.File(out, "r") as f:
             n = f["particles/J"].shape[0]
             if name == "series":
-                check(steps == times, f"{name}: ParaView's time steps {steps}, not the output times {times}")
-                for k, t in enumerate(times):
+                check(steps == TIMES, f"{name}: ParaView's time steps {steps}, not the output times {TIMES}")
+                for k, t in enumerate(TIMES):
                     points, cells, arrays = points_at(reader, t)
                     check(points == cells == n, f"{name} t = {t}: {points} points and {cells} cells, not {n}")
                     for field, width in (("displacement", 2), ("velocity", 2), ("J", 1), ("stress", 4),

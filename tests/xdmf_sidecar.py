@@ -16,7 +16,6 @@ where ParaView is installed.
     /usr/bin/python3 tests/xdmf_sidecar.py MPMVV   (ctest runs it; exit 1 names what failed)
 """
 import copy
-import subprocess
 import sys
 import tempfile
 import xml.etree.ElementTree as ET
@@ -26,8 +25,9 @@ import h5py
 import meshio
 import numpy as np
 
+from sidecar_runs import TIMES, sidecar_runs
+
 MPMVV = sys.argv[1]
-SOURCE = Path(__file__).resolve().parents[1]
 failures = []
 
 
@@ -64,23 +64,15 @@ def read_grid(document, path):
 
 with tempfile.TemporaryDirectory() as tmp:
     tmp = Path(tmp)
-    times = [0.05, 0.1, 0.15, 0.2]
-    for name, extra in (("series", ["--set", "particle_fields=outputs"]), ("end", [])):
-        out = tmp / f"{name}.h5"
-        ran = subprocess.run([MPMVV, "run", SOURCE / "suites" / "scenes" / "ring.toml", "--set", "cells=32",
-                              "--set", "end_time=0.2", "--set", f"output_times=[{','.join(map(str, times))}]",
-                              *extra, "--threads", "1", "--quiet", "-o", out], capture_output=True, text=True)
-        xmf = out.with_suffix(".xmf")
-        if ran.returncode != 0 or not xmf.is_file():
-            sys.exit(f"mpmvv run {name}: exit {ran.returncode}, {ran.stderr}")
-        read = list(grids(xmf))
+    for name, out in sidecar_runs(MPMVV, tmp):
+        read = list(grids(out.with_suffix(".xmf")))
         with h5py.File(out, "r") as f:
             index = f["particle_index"][...]
             if name == "series":
-                expected = [(t, f[f"snapshots/{k}"]) for k, t in enumerate(times)]
+                expected = [(t, f[f"snapshots/{k}"]) for k, t in enumerate(TIMES)]
                 fields = ("displacement", "velocity", "J", "stress", "deformation_gradient", "displacement_error")
             else:
-                expected = [(times[-1], f["particles"])]
+                expected = [(TIMES[-1], f["particles"])]
                 fields = ("velocity", "J", "deformation_gradient")
             check([t for t, _ in read] == [t for t, _ in expected],
                   f"{name}: the sidecar's times {[t for t, _ in read]}, not {[t for t, _ in expected]}")
