@@ -10,6 +10,18 @@ import numpy as np
 import pytest
 
 
+def configuration_text(keys):
+    """The `configuration` attribute a run writes: its resolved keys as TOML
+    (the gate checks them against the manifest's, reports/consistency.py)."""
+    def value(v):
+        if isinstance(v, bool):
+            return "true" if v else "false"
+        if isinstance(v, (list, tuple)):
+            return "[" + ", ".join(value(x) for x in v) + "]"
+        return json.dumps(v) if isinstance(v, str) else repr(v)
+    return "".join(f"{k} = {value(v)}\n" for k, v in keys.items())
+
+
 def write_ring_results(path, cells, l1_at_times, times, method="cpdi", amplitude=0.5,
                        status="completed", failure_reason="", failure_time=float("nan")):
     h = 3.0 / cells
@@ -71,6 +83,7 @@ def write_case_results(path, keys, h, errors_at_times, times, status="completed"
     with h5py.File(path, "w") as f:
         for name, value in keys.items():
             f.attrs[name] = np.asarray(value, dtype=float) if isinstance(value, list) else value
+        f.attrs["configuration"] = configuration_text(keys)
         f.attrs.update({"h": h, "status": status, "failure_reason": failure_reason, "failure_time": failure_time,
                         "time_reached": end_time if status == "completed" else failure_time,
                         "wall_time_s": wall_time_s, "end_time": end_time, "steps": np.int64(100),

@@ -36,8 +36,13 @@ L1_<line> norm's line, the RMS exact displacement for particle_L1, _L2,
 _Linf) is below TRIVIAL_SIGNAL (5 %) of its largest over the run is warned
 about in the row: a run without the motion would score nearly the same there.
 
+Before any of that, every result is checked against its case
+(reports/consistency.py: status, keys, one file per case, the time axis, the
+norms' values, paths inside DIR); a result that fails is named on stderr, its
+numbers are not used, and the gate fails.
+
 Prints one row per (expectation, series) and a closing line; exit 0 when every
-expectation holds, 1 when one falls short, 2 (one line) when DIR is not a
+expectation holds and every result is its case's, 1 otherwise, 2 (one line) when DIR is not a
 readable suite output directory. The [[expect]] tables are the manifest's, which
 `mpmvv suite` checked when it loaded the suite (its one check of them).
 
@@ -201,6 +206,8 @@ def _level_outcome(series, level):
     if level.case is None:
         return level.reason
     case = level.case
+    if case.problems:
+        return f"{series.refine}={level.value} results not its case's ({'; '.join(case.problems)})"
     outcome = case.status
     if case.status == "failed" and math.isfinite(case.time_reached):
         outcome += f" at t = {case.time_reached:.3g}"
@@ -326,13 +333,26 @@ def main(argv):
                 print(f"mpmvv gate: cannot write {path}: {error.strerror}", file=sys.stderr)
                 return 2
     name = suite.name if suite.tier == "full" else f"{suite.name} ({suite.tier} tier)"
+    print_problems(suite, "mpmvv gate")
     if not suite.expectations:
         print(f"{name}: no [[expect]] in the suite; nothing to check")
-        return 0
+        return 1 if suite.problems else 0
     print(f"{name}: {len(suite.expectations)} expectations")
     print(format_table([verdict_row(v) for v in verdicts]))
-    print(summary_line(verdicts, len(suite.expectations)))
-    return 0 if all(v.passed for v in verdicts) else 1
+    print(summary_line(verdicts, len(suite.expectations)) +
+          (f"; FAIL: {len(suite.problems)} result problem(s) above" if suite.problems else ""))
+    return 0 if all(v.passed for v in verdicts) and not suite.problems else 1
+
+
+def print_problems(suite, program):
+    """The results not checked to be their cases' (reports/consistency.py), each
+    on a line of stderr: they make the verdict FAIL, whatever the rows say."""
+    if not suite.problems:
+        return
+    print(f"{program}: {suite.directory}: {len(suite.problems)} result(s) not their cases' or damaged; "
+          "no verdict rests on them and the gate fails:", file=sys.stderr)
+    for problem in suite.problems:
+        print(f"  {problem}", file=sys.stderr)
 
 
 if __name__ == "__main__":

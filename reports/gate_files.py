@@ -14,7 +14,9 @@ that is not finite (no fit, an unusable level) is null.
 """
 import json
 import math
+import os
 import xml.etree.ElementTree as ET
+from pathlib import Path
 
 from .gate import series_description, verdict_row
 
@@ -69,24 +71,41 @@ def verdict_record(verdict):
 
 def gate_record(suite, verdicts):
     return {"suite": suite.name, "expectations": len(suite.expectations),
-            "holds": all(v.passed for v in verdicts),
+            "holds": all(v.passed for v in verdicts) and not suite.problems,
+            "problems": list(suite.problems),
             "verdicts": [verdict_record(v) for v in verdicts]}
 
 
+def write_atomically(path, text):
+    """`text` under `path` whole or not at all (a full disk leaves no partial file under the name)."""
+    path = Path(path)
+    temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        temporary.write_text(text, encoding="utf-8")
+        os.replace(temporary, path)
+    finally:
+        temporary.unlink(missing_ok=True)
+
+
 def write_json(path, suite, verdicts):
-    with open(path, "w", encoding="utf-8") as out:
-        json.dump(gate_record(suite, verdicts), out, indent=1, allow_nan=False)
-        out.write("\n")
+    write_atomically(path, json.dumps(gate_record(suite, verdicts), indent=1, allow_nan=False) + "\n")
 
 
 def junit_tree(suite, verdicts):
     """<testsuites><testsuite name=SUITE> with one <testcase> per verdict; a
     failing one holds a <failure> with the reasons; the row's observed and
     expected values are the test case's properties and its system-out."""
-    failures = sum(not v.passed for v in verdicts)
-    root = ET.Element("testsuites", name="mpmvv gate", tests=str(len(verdicts)), failures=str(failures))
-    group = ET.SubElement(root, "testsuite", name=suite.name, tests=str(len(verdicts)), failures=str(failures),
+    failures = sum(not v.passed for v in verdicts) + bool(suite.problems)
+    tests = len(verdicts) + bool(suite.problems)
+    root = ET.Element("testsuites", name="mpmvv gate", tests=str(tests), failures=str(failures))
+    group = ET.SubElement(root, "testsuite", name=suite.name, tests=str(tests), failures=str(failures),
                           errors="0", skipped="0")
+    if suite.problems:
+        # Results not checked to be their cases' (reports/consistency.py): the gate's first failure.
+        case = ET.SubElement(group, "testcase", classname=f"{suite.name}.results", name="results match their cases")
+        failure = ET.SubElement(case, "failure", message=f"{len(suite.problems)} result problem(s)",
+                                type="consistency")
+        failure.text = "\n".join(suite.problems)
     for verdict in verdicts:
         row = verdict_row(verdict)
         record = verdict_record(verdict)
@@ -108,4 +127,5 @@ def junit_tree(suite, verdicts):
 def write_junit(path, suite, verdicts):
     tree = junit_tree(suite, verdicts)
     ET.indent(tree)
-    tree.write(path, encoding="utf-8", xml_declaration=True)
+    write_atomically(path, "<?xml version='1.0' encoding='utf-8'?>\n" +
+                      ET.tostring(tree.getroot(), encoding="unicode") + "\n")

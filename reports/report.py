@@ -37,7 +37,8 @@ from .report_rows import LEVELS_CSV_COLUMNS, ORDERS_CSV_COLUMNS, gci_rows, order
 from .report_tables import (case_table, expectation_table, gci_table, measurement_sections, orders_table,
                            reference_sections, write_gci_csv, write_levels_csv,
                            write_orders_csv)
-from .results import SuiteDirectoryError, read_suite
+from .results import Suite, SuiteDirectoryError, read_suite
+from .gate_files import write_atomically
 from .summary_file import write_summary
 
 
@@ -137,10 +138,21 @@ def build_report(suite, figure_directory, progress=None):
                   sections, entries, verdicts, gate_error, glossary, summary)
 
 
+FIGURE_LIST = ".figures-written"   # in OUT/figures: the figures this report wrote, the next one replaces
+PROBLEMS_SHOWN = 20   # result problems listed on the report's first screen
+
+
 def verdict_lines(report):
     """The gate's verdict in a line (PASS, FAIL, not checked, or no expectations),
     then one line for each series that fell short: what the report opens with."""
     suite = report.suite
+    if suite.problems:
+        # Results not checked to be their cases' (consistency.py): no verdict rests on them.
+        shown = suite.problems[:PROBLEMS_SHOWN]
+        more = len(suite.problems) - len(shown)
+        return "fail", [f"Verdict: FAIL. {len(suite.problems)} result(s) are not their cases' or are damaged; "
+                        "their numbers are left out of every table and figure below:"] + shown + \
+            ([f"and {more} more (mpmvv gate lists them all)"] if more > 0 else [])
     if not suite.expectations:
         return "none", ["Verdict: none. This suite has no [[expect]], so it gates nothing; its cases and "
                         "figures follow."]
@@ -277,13 +289,22 @@ def render_markdown(report, output_directory):
 def write_report(directory, output=None, progress=None):
     """Read the suite, write every output; returns the paths written
     (`progress` as for build_report)."""
-    suite = read_suite(directory)
+    suite = directory if isinstance(directory, Suite) else read_suite(directory)
     output = Path(output) if output else suite.directory / "report"
     figure_directory = output / "figures"
     figure_directory.mkdir(parents=True, exist_ok=True)
-    for old in figure_directory.glob("*.png"):
-        old.unlink()
+    # Only the figures an earlier report wrote here go (FIGURE_LIST names
+    # them): a file of the user's in the same folder stays.
+    listed = figure_directory / FIGURE_LIST
+    if listed.is_file():
+        for name in listed.read_text().splitlines():
+            if name and "/" not in name and name.endswith(".png"):
+                (figure_directory / name).unlink(missing_ok=True)
+    before = {p.name: p.stat().st_mtime_ns for p in figure_directory.glob("*.png")}
     report = build_report(suite, figure_directory, progress)
+    written_figures = sorted(p.name for p in figure_directory.glob("*.png")
+                             if before.get(p.name) != p.stat().st_mtime_ns)
+    write_atomically(listed, "".join(f"{name}\n" for name in written_figures))
     written = {"html": output / "report.html", "markdown": output / "report.md",
                "orders": output / "orders.csv", "levels": output / "levels.csv", "gci": output / "gci.csv",
                "summary": output / "summary.json"}
@@ -303,7 +324,10 @@ class _OneLineParser(argparse.ArgumentParser):
 
 def main(argv):
     parser = _OneLineParser(prog="mpmvv report", description="Tables, figures and report.html of a suite output "
-                            "directory, from its results files only.")
+                            "directory, from its results files only.",
+                            epilog="Exit 0: written; 1: written, but some results are not their cases' or are "
+                                   "damaged (listed on stderr and first in the report; reports/consistency.py); "
+                                   "2: not a suite directory, or the report cannot be written.")
     parser.add_argument("directory", metavar="DIR", help="a suite output directory (mpmvv suite SUITE -o DIR)")
     parser.add_argument("-o", "--output", metavar="OUT", help="where to write (default DIR/report)")
     parser.add_argument("-q", "--quiet", action="store_true", help="no progress lines on stderr")
@@ -317,7 +341,8 @@ def main(argv):
         print(f"mpmvv report: {step} ({now})", file=sys.stderr, flush=True)
 
     try:
-        written, figure_count = write_report(args.directory, args.output, None if args.quiet else progress)
+        suite = read_suite(args.directory)
+        written, figure_count = write_report(suite, args.output, None if args.quiet else progress)
     except SuiteDirectoryError as error:
         print(f"mpmvv report: {error}", file=sys.stderr)
         return 2
@@ -331,7 +356,9 @@ def main(argv):
         print(f"wrote {path}")
     print(f"{figure_count} figures in {written['html'].parent / 'figures'}; "
           f"{clock.perf_counter() - start:.1f} s")
-    return 0
+    # Results that are not their cases': the report says so first, and so does its exit.
+    gate.print_problems(suite, "mpmvv report")
+    return 1 if suite.problems else 0
 
 
 if __name__ == "__main__":

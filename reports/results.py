@@ -20,6 +20,7 @@ scales.py.
 """
 import json
 import math
+import stat
 import tomllib
 from dataclasses import dataclass, field
 from datetime import datetime
@@ -27,6 +28,8 @@ from pathlib import Path
 
 import h5py
 import numpy as np
+
+from . import consistency
 
 CASE_STATUSES = ("completed", "lost", "failed", "crashed", "timeout", "error", "pending")
 TIME_MATCH_TOLERANCE = 1e-9   # relative; output times are written from the same decimal values
@@ -60,6 +63,7 @@ class Case:
     manifest_wall_time_s: float = float("nan")
     results: CaseResults = None
     note: str = ""                # why there are no results, when there are none
+    problems: tuple = ()          # why its results are not its case's (consistency.py); results then None
 
     def attribute(self, name, default=float("nan")):
         if self.results is not None and name in self.results.attributes:
@@ -109,6 +113,7 @@ class Suite:
     references: list = field(default_factory=list)     # [[reference]] tables of suite.toml (references.py)
     cases: list = field(default_factory=list)
     tier: str = "full"                                 # the tier that ran (suites/README.md, "Tiers")
+    problems: list = field(default_factory=list)       # results not checked to be their cases' (consistency.py)
 
     def study_names(self):
         names = [s.get("name") for s in self.studies if isinstance(s.get("name"), str)]
@@ -141,7 +146,8 @@ def read_suite(directory):
     manifest_path = directory / "manifest.json"
     manifest = _read_manifest(manifest_path)
     suite_path = directory / "suite.toml"
-    suite_file = _read_suite_file(suite_path) if suite_path.is_file() else {}
+    suite_text = _read_text(suite_path) if suite_path.exists() else None
+    suite_file = _parse_suite_file(suite_path, suite_text) if suite_text is not None else {}
     studies = suite_file.get("study", [])
     references = suite_file.get("reference", [])
     tier = manifest.get("tier", "full")
@@ -155,6 +161,13 @@ def read_suite(directory):
     expectations = manifest.get("expectations", [])
     if not isinstance(expectations, list) or not all(isinstance(e, dict) for e in expectations):
         raise SuiteDirectoryError(f"{manifest_path}: 'expectations' must be an array of objects")
+    for number, expect in enumerate(expectations, start=1):
+        problem = _expectation_problem(expect)
+        if problem:
+            raise SuiteDirectoryError(f"{manifest_path}: expectation {number}: {problem}")
+    cases = [_read_case(directory, entry) for entry in manifest["cases"]]
+    problems = [f"case '{c.id}': {p}" for c in cases for p in c.problems]
+    problems += consistency.suite_problems(manifest, suite_text, suite_file, cases)
     return Suite(
         directory=directory,
         name=str(manifest.get("suite", directory.name)),
@@ -167,17 +180,18 @@ def read_suite(directory):
         # Published numbers sit beside the full study's levels, which the
         # ci tier does not run (mpmvv suite checks them in the full tier).
         references=references if tier == "full" else [],
-        cases=[_read_case(directory, entry) for entry in manifest["cases"]],
+        cases=cases,
         tier=tier,
+        problems=problems,
     )
 
 
 def _read_manifest(path):
-    if not path.is_file():
+    if not path.exists() and not path.is_symlink():
         raise SuiteDirectoryError(f"{path}: missing; not a suite output directory (mpmvv suite SUITE -o DIR writes it)")
     try:
-        manifest = json.loads(path.read_text())
-    except (json.JSONDecodeError, UnicodeDecodeError) as error:
+        manifest = json.loads(_read_text(path))
+    except json.JSONDecodeError as error:
         raise SuiteDirectoryError(f"{path}: not valid JSON ({error})") from None
     if not isinstance(manifest, dict) or not isinstance(manifest.get("cases"), list):
         raise SuiteDirectoryError(f"{path}: expected an object with a 'cases' array")
@@ -190,11 +204,54 @@ def _read_manifest(path):
     return manifest
 
 
-def _read_suite_file(path):
+def _read_text(path):
+    """A regular file's text; a FIFO, device, directory or loop is refused at once, not read."""
     try:
-        return tomllib.loads(path.read_text())
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
+        if not stat.S_ISREG(path.stat().st_mode):
+            raise SuiteDirectoryError(f"{path}: not a regular file")
+        return path.read_text()
+    except UnicodeDecodeError:
+        raise SuiteDirectoryError(f"{path}: not UTF-8 text") from None
+    except (OSError, RuntimeError) as error:
+        raise SuiteDirectoryError(f"{path}: cannot be read ({getattr(error, 'strerror', None) or error})") from None
+
+
+def _parse_suite_file(path, text):
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
         raise SuiteDirectoryError(f"{path}: not valid TOML ({error})") from None
+
+
+# What each recorded expectation's keys must hold (the loader wrote them; a
+# manifest edited since must not reach the gate's arithmetic as text).
+_EXPECTATION_KINDS = {"study": str, "norm": str, "refine": str, "order": (int, float), "tolerance": (int, float),
+                      "max_error": (int, float), "max_error_constant": (int, float), "time": (int, float),
+                      "where": dict, "levels": list, "must_complete": bool, "at_roundoff": bool,
+                      "interval_within_band": bool}
+
+
+def _expectation_problem(expect):
+    for key in ("study", "norm"):
+        if key not in expect:
+            return f"no '{key}'"
+    for key, kind in _EXPECTATION_KINDS.items():
+        value = expect.get(key)
+        if value is None:
+            if key in expect:
+                return f"'{key}' is null"
+            continue
+        numeric_bool = kind != bool and isinstance(value, bool)
+        if not isinstance(value, kind) or numeric_bool:
+            return f"'{key}' is {value!r}, not {_KIND_NAMES[kind]}"
+        if isinstance(value, float) and not math.isfinite(value):
+            return f"'{key}' is {value!r}, not a finite number"
+    if "order" in expect and "tolerance" not in expect:
+        return "'order' without 'tolerance'"
+    return ""
+
+
+_KIND_NAMES = {str: "text", (int, float): "a number", dict: "a table", list: "an array", bool: "true or false"}
 
 
 def read_results_file(path):
@@ -207,26 +264,39 @@ def read_results_file(path):
 
 
 def _read_case(directory, entry):
-    results_path = directory / entry.get("results", f"cases/{entry['id']}.h5")
+    """A manifest entry and its results file, checked against each other (consistency.py):
+    a case with a problem keeps it in `problems`, its results None."""
     wall_time = entry.get("wall_time_s")
+    problems = [p for p in (consistency.id_problem(entry["id"]),) if p]
+    results_path, path_problem = consistency.results_path(directory, entry)
+    problems += [path_problem] if path_problem else []
     results, note = None, ""
-    if results_path.is_file():
+    status = entry.get("status")
+    if status not in CASE_STATUSES:
+        problems.append(f"the manifest's status {status!r} is none of {', '.join(CASE_STATUSES)}")
+        status = "error"
+    if results_path is not None and not problems and results_path.is_file():
         try:
             results = read_case_results(results_path)
         except (OSError, KeyError, ValueError, TypeError) as error:
             note = f"unreadable results file ({error})"
-    elif entry.get("status") not in ("pending", None):
+            if status in consistency.ENDED:
+                problems.append(note)
+        if results is not None:
+            problems += consistency.case_problems(entry, status, results)
+    elif results_path is not None and status not in ("pending",):
         note = "no results file"
-    status = entry.get("status")
-    if status not in CASE_STATUSES:
-        status = results.attributes.get("status", "pending") if results is not None else "pending"
+        if status in consistency.ENDED:
+            problems.append(f"the manifest says {status}, and it has no results file")
     # The results file's own verdict wins over a manifest that called the run completed.
     if status == "completed" and results is not None and results.attributes.get("status") == "lost":
         status = "lost"
+    if problems:
+        results, note = None, "; ".join(problems)
     return Case(id=entry["id"], study=entry["study"], keys=dict(entry.get("keys", {})), status=status,
-                detail=str(entry.get("detail", "")), results_path=results_path,
+                detail=str(entry.get("detail", "")), results_path=results_path or Path(directory),
                 manifest_wall_time_s=float(wall_time) if isinstance(wall_time, (int, float)) else float("nan"),
-                results=results, note=note)
+                results=results, note=note, problems=tuple(problems))
 
 
 def plain(value):
@@ -245,6 +315,10 @@ def read_case_results(path):
         errors_group = f.get("errors")
         errors, error_times = {}, np.zeros(0)
         if errors_group is not None:
+            # Numbers stored as numbers: text that reads as one is still a damaged file.
+            for name, item in errors_group.items():
+                if not isinstance(item, h5py.Dataset) or item.dtype.kind not in "fiu":
+                    raise ValueError(f"/errors/{name} holds {getattr(item, 'dtype', 'a group')}, not numbers")
             error_times = np.asarray(errors_group["time"][:], float) if "time" in errors_group else np.zeros(0)
             errors = {name: np.asarray(errors_group[name][:], float) for name in errors_group if name != "time"}
             # One value per output time (reports/results-format.md); anything else is a damaged file.

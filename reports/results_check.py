@@ -7,7 +7,7 @@ What is checked is what the report and the gate read: the root attributes a
 run writes whatever its scene (their types and allowed values, and that
 status, failure and health agree), /particles (one row per particle, the
 shapes of the table), /errors (a `time` column, increasing, and every column
-as long), /probes/monitors and /probes/coverage likewise, each probe group's `quantity` and the
+as long, numbers, each value a norm's: finite and >= 0), /probes/monitors and /probes/coverage likewise, each probe group's `quantity` and the
 shape of its values against its `time` and points. A file an external code's
 run was ingested into is held to the same rules.
 
@@ -15,10 +15,14 @@ Usage: mpmvv results check FILE [FILE ...]
 """
 import argparse
 import math
+import os
+import stat
 import sys
 
 import h5py
 import numpy as np
+
+from .consistency import norm_problems
 
 STATUSES = ("completed", "lost", "failed", "interrupted")
 GEOMETRIES = ("plane-strain", "axisymmetric")
@@ -31,7 +35,7 @@ ROOT = {
     "failure_detail": "text", "health": "text", "health_reason": "text", "geometry": "text", "threads": "int",
     "steps": "int", "particle_count": "int", "particle_steps": "int", "failure_step": "int",
     "failure_particle": "int", "time_reached": "real", "failure_time": "real", "health_time": "real",
-    "wall_time_s": "real", "h": "real", "end_time": "real",
+    "wall_time_s": "real", "h": "real", "end_time": "real", "cells": "int",
 }
 # /particles dataset -> its shape after N.
 PARTICLES = {"reference_position": (2,), "position": (2,), "velocity": (2,), "volume": (), "J": (),
@@ -162,6 +166,24 @@ def check_errors(f, problems):
     time = check_table(f, "errors", problems)
     if time is None:
         return
+    # Values as well as layout: numbers stored as numbers, one per output
+    # time, and each a norm's (consistency.norm_problems: finite and >= 0; NaN
+    # only where nothing was measured).
+    healthy = _text(f.attrs.get("status", "")) == "completed" and _text(f.attrs.get("health", "")) != "solution lost"
+    for name, item in f["errors"].items():
+        if not isinstance(item, h5py.Dataset):
+            problems.append(f"/errors/{name}: a group, the format has a column")
+        elif item.dtype.kind not in "fiu":
+            problems.append(f"/errors/{name}: {item.dtype} values, the format has numbers")
+        elif item.ndim != 1:
+            problems.append(f"/errors/{name}: {item.ndim} dimensions, the format has 1")
+        elif name == "time":
+            if not np.all(np.isfinite(time)):
+                problems.append("/errors/time: not finite")
+        elif item.shape == time.shape:
+            problem = norm_problems(name, time, np.asarray(item, float), healthy)
+            if problem:
+                problems.append(problem)
     if _text(f.attrs.get("status", "")) == "completed" and time.size and "end_time" in f.attrs:
         end = float(f.attrs["end_time"])
         if not math.isclose(float(time[-1]), end, rel_tol=1e-9, abs_tol=1e-12):
@@ -190,6 +212,9 @@ def check_external(f, problems):
 def check_file(path):
     """The problems of one results file (empty when it follows the format); raises OSError if unreadable."""
     problems = []
+    # A FIFO would block the reader, a device or directory is no file.
+    if not stat.S_ISREG(os.stat(path).st_mode):
+        raise OSError(f"{path} is not a regular file")
     with h5py.File(path, "r") as f:
         check_root(f, problems)
         check_particles(f, problems)

@@ -6,11 +6,12 @@ a suite from one file.
 
 {"format_version": 1, "suite", "description", "directory", "generated",
  "status_counts": {status: count},
+ "problems": [results not their cases' or damaged, one line each (consistency.py)],
  "cases": [{"id", "study", "keys" (the keys its study sweeps or zips),
             "status", "health", "failure_reason", "time_reached", "h",
             "particle_count", "steps", "wall_time_s", "external" (run by
             another program: external_command), "results" (path, relative to
-            the directory)}],
+            the directory), "problems" (this case's)}],
  "gate": {"expectations", "holds", "verdicts": [...]} or null without
          expectations (or when they could not be checked: "gate_error"),
  "orders": [{column of orders.csv: value}]}
@@ -19,7 +20,7 @@ A number that is not finite is null.
 import json
 import numbers
 
-from .gate_files import _number, gate_record
+from .gate_files import _number, gate_record, write_atomically
 from .report_rows import ORDERS_CSV_COLUMNS
 from .report_tables import order_row_values
 
@@ -50,7 +51,7 @@ def case_record(suite, case):
             "time_reached": _number(case.time_reached), "h": _number(case.h),
             "particle_count": _integer(case.attribute("particle_count")), "steps": _integer(case.attribute("steps")),
             "wall_time_s": _number(case.wall_time_s), "external": bool(case.keys.get("external_command")),
-            "results": path}
+            "results": path, "problems": list(case.problems)}
 
 
 def summary_record(report):
@@ -59,6 +60,7 @@ def summary_record(report):
     record = {"format_version": 1, "suite": suite.name, "description": suite.description,
               "directory": str(suite.directory), "generated": report.generated.isoformat(timespec="seconds"),
               "status_counts": report.status_counts,
+              "problems": list(suite.problems),
               "cases": [case_record(suite, c) for c in suite.cases],
               "gate": gate_record(suite, report.verdicts) if report.verdicts is not None else None,
               "orders": [dict(zip(names, map(_value, order_row_values(r)))) for r in report.order_rows]}
@@ -68,6 +70,4 @@ def summary_record(report):
 
 
 def write_summary(path, report):
-    with open(path, "w", encoding="utf-8") as out:
-        json.dump(summary_record(report), out, indent=1, allow_nan=False)
-        out.write("\n")
+    write_atomically(path, json.dumps(summary_record(report), indent=1, allow_nan=False) + "\n")

@@ -109,6 +109,24 @@ TEST(SuiteFile, MistakesNameFileLineAndKey) {
        "s.toml:8: [[expect]]: 'at_roundoff' must be true or false"},
       {study + "sweep = { cells = [32, 64] }\n[[expect]]\nstudy = \"a\"\nnorm = \"L1_theta0\"\nat_roundoff = false\n",
        "[[expect]] needs 'order' (a number), or 'max_error' or 'at_roundoff = true' alone"},
+      // Found at load, not by the gate after every case ran.
+      {study + "sweep = { cells = [32, 64] }\n[[expect]]\nstudy = \"a\"\nnorm = \"L1_theta9\"\nmax_error = 1.0\n",
+       "s.toml:7: [[expect]]: study 'a' writes no /errors column 'L1_theta9'; its columns: L1_theta0"},
+      {study + "sweep = { cells = [32, 64] }\n[[expect]]\nstudy = \"a\"\nnorm = \"L1_theta0\"\ntime = 0.33\n"
+               "max_error = 1.0\n",
+       "s.toml:8: [[expect]]: t = 0.33 is not an output time of case 'a-cells=32'"},
+      {study + "sweep = { cells = [32, 64] }\n[[expect]]\nstudy = \"a\"\nwhere = { method = \"gimp\" }\n"
+               "norm = \"L1_theta0\"\nmax_error = 1.0\n",
+       "s.toml:5: [[expect]]: where method=gimp matches no case of study 'a'"},
+      {study + "sweep = { cells = [32, 64], amplitude = [0.5, 1.0] }\n[[expect]]\nstudy = \"a\"\n"
+               "norm = \"L1_theta0\"\nrefine = \"amplitude\"\norder = 2\ntolerance = 0.1\n",
+       "'refine' = \"amplitude\" sets no size an order is observed against"},
+      {study + "sweep = { cells = [32, 64] }\n[[study.override]]\nwhere = { cells = 128 }\nset = { cfl = 0.2 }\n",
+       "study 'a': [[study.override]] 1 where cells=128 matches none of its cases"},
+      {study + "sweep = { cells = [32, 64], cfl = [0.1, 0.2, 0.3, 0.4, 0.5], end_time = [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7,"
+               " 0.8, 0.9, 1.0], amplitude = [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0], density = [1.0, 2.0, "
+               "3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0, 10.0, 11.0] }\n",
+       "study 'a' makes 11000 cases (0 before it), more than the 10000 a suite may hold"},
       {study + "set = { inner_radius = 1.3 }\n", "key 'outer_radius': must exceed inner_radius = 1.3 (from"},
       {study + "set = { cells = 16 }\n", "key 'cells': the ring (outer radius 1.25 m) needs two cells of clearance "
                                          "inside the 3 m domain, and cells = 16 makes h = 0.1875 m: use cells >= 24, "

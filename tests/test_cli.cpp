@@ -1,6 +1,7 @@
 // The built `mpmvv` command line: bad input exits with status 2 and one line
 // on stderr naming what is wrong, writes no results file, and help exits 0.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -58,11 +59,12 @@ class Cli : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(directory_); }
 
-  // Runs `mpmvv <arguments>` with stdout and stderr captured in files.
-  Outcome mpmvv(const std::string& arguments) const {
+  // Runs `mpmvv <arguments>` (or, program = false, the command `arguments`)
+  // with stdout and stderr captured in files.
+  Outcome mpmvv(const std::string& arguments, bool program = true) const {
     const fs::path out = directory_ / "stdout.txt", err = directory_ / "stderr.txt";
-    const std::string command =
-        quoted(MPMVV_BINARY) + " " + arguments + " >" + quoted(out.string()) + " 2>" + quoted(err.string()) + " </dev/null";
+    const std::string command = (program ? quoted(MPMVV_BINARY) + " " : std::string()) + arguments + " >" +
+                                quoted(out.string()) + " 2>" + quoted(err.string()) + " </dev/null";
     const int raw = std::system(command.c_str());
     EXPECT_TRUE(WIFEXITED(raw)) << command;
     return {WEXITSTATUS(raw), read_file(out), read_file(err)};
@@ -141,6 +143,52 @@ TEST_F(Cli, DescribeListsResolvedKeys) {
   EXPECT_NE(o.out.find("cells = 40"), std::string::npos) << o.out;
   EXPECT_NE(o.out.find("--set cells=40"), std::string::npos) << o.out;
   EXPECT_NE(o.out.find("output_times = "), std::string::npos) << o.out;
+}
+
+// Files that are not TOML files (a FIFO, which would block a reader, a
+// directory, a symlink loop, which made the filesystem library throw) and
+// numbers that are not numbers (NaN passes every comparison): each refused at
+// once, exit 2, one line naming the file or option; none hangs (each command
+// is given 30 s).
+TEST_F(Cli, FilesThatAreNotFilesAndNanAreRefusedAtOnce) {
+  const fs::path fifo = directory_ / "fifo.toml", loop = directory_ / "loop.toml", five = directory_ / "five.toml";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  fs::create_symlink(loop.filename(), loop);
+  std::ofstream(five) << "scene = 5\n";
+  const std::string ring = ring_scene(), fifo_q = quoted(fifo.string()), loop_q = quoted(loop.string());
+  const struct {
+    std::string arguments, says;
+  } corpus[] = {
+      {"run " + fifo_q + " -q -o " + results(), "not a regular file"},
+      {"run " + quoted(directory_.string()) + " -q -o " + results(), "not a regular file"},
+      {"run " + loop_q + " -q -o " + results(), "cannot read this scene file"},
+      {"suite " + fifo_q + " --list", "not a regular file"},
+      {"suite " + loop_q + " --list", "cannot read this suite file"},
+      {"run " + quoted(five.string()) + " -q -o " + results(), "five.toml:1: 'scene' must be the name of a scene"},
+      {"run " + ring + " --pause-at nan -q -o " + results(), "--pause-at"},
+      {"run " + ring + " --checkpoint-every nan -q -o " + results(), "--checkpoint-every"},
+      {"suite " + quoted(std::string(MPMVV_SOURCE_DIR) + "/suites/ring-quick.toml") + " --list --budget nan",
+       "--budget"},
+      {"mms eval ring --at 1,0 --time nan", "--time"},
+      {"results check " + fifo_q, "not a regular file"},
+  };
+  for (const auto& c : corpus) {
+    const Outcome o = mpmvv("timeout 30 " + quoted(MPMVV_BINARY) + " " + c.arguments, /*program=*/false);
+    EXPECT_EQ(o.status, 2) << c.arguments << "\n" << o.err;
+    EXPECT_NE(o.err.find(c.says), std::string::npos) << c.arguments << "\n" << o.err;
+    EXPECT_EQ(lines_of(o.err).size(), 1u) << c.arguments << "\n" << o.err;
+    EXPECT_FALSE(results_written()) << c.arguments;
+  }
+}
+
+// A ring whose outer radius rounds a probe line's end an ulp outside it
+// (0.85 * 1.0 placed as 0.8500000000000001) is the valid ring it is.
+TEST_F(Cli, AProbeOnTheRimIsOnTheBodyDespiteRounding) {
+  for (const char* outer : {"0.85", "0.9"}) {
+    const Outcome o = mpmvv("run " + ring_scene() + " -q -t 1 --set inner_radius=0.3 --set outer_radius=" + outer +
+                            " --set end_time=0.001 --set output_times=[0.001] -o " + results());
+    EXPECT_EQ(o.status, 0) << outer << "\n" << o.err;
+  }
 }
 
 // ---------------------------------------------------------------- mpmvv mms

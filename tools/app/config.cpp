@@ -259,13 +259,15 @@ std::string Config::to_toml() const {
 Config load_scene_file(const std::string& path,
                        const std::function<std::optional<std::vector<KeySpec>>(const std::string&)>& specs_for_scene,
                        const std::vector<std::string>& overrides) {
-  if (!std::filesystem::exists(path)) throw ConfigError(fmt::format("{}: no such scene file", path));
-  const toml::table table = parse_toml_file(path);
+  const toml::table table = parse_toml_file(path, "scene file");
   auto where = [&](const toml::node& n) { return fmt::format("{}:{}", path, n.source().begin.line); };
 
   const toml::node* scene_node = table.get("scene");
-  if (!scene_node || !scene_node->is_string())
+  if (!scene_node)
     throw ConfigError(fmt::format("{}: missing key 'scene' (the name of the scene, a string such as \"ring\")", path));
+  if (!scene_node->is_string())
+    throw ConfigError(fmt::format("{}: 'scene' must be the name of a scene, a string such as \"ring\"",
+                                  where(*scene_node)));
   const std::string scene = scene_node->as_string()->get();
   const auto specs = specs_for_scene(scene);
   if (!specs) throw ConfigError(fmt::format("{}: key 'scene': unknown scene '{}'", where(*scene_node), scene));

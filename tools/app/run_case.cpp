@@ -248,22 +248,21 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
   if (!request.quiet)
     fmt::print(err, "mpmvv run {} -> {} ({} threads)\nconfiguration:{}\n", request.scene_file, output, max_threads(),
                compact(config));
-  // SIGINT and SIGTERM end the run at its next step, and what it computed is
-  // written, marked "interrupted" (a second signal kills as usual).
+  // SIGINT, SIGTERM and SIGHUP (a closed terminal) end the run at its next
+  // step, and what it computed is written, marked "interrupted" (a second
+  // signal kills as usual).
   struct sigaction action {};
   action.sa_handler = [](int) { stop_request().store(true, std::memory_order_relaxed); };
   action.sa_flags = SA_RESETHAND;
   sigemptyset(&action.sa_mask);
-  struct sigaction before_int {}, before_term {};
-  sigaction(SIGINT, &action, &before_int);
-  sigaction(SIGTERM, &action, &before_term);
+  static constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP};
   struct Restore {
-    struct sigaction interrupt, terminate;
+    struct sigaction before[3] = {};
     ~Restore() {
-      sigaction(SIGINT, &interrupt, nullptr);
-      sigaction(SIGTERM, &terminate, nullptr);
+      for (int i = 0; i < 3; ++i) sigaction(kStopSignals[i], &before[i], nullptr);
     }
-  } restore{before_int, before_term};
+  } restore;
+  for (int i = 0; i < 3; ++i) sigaction(kStopSignals[i], &action, &restore.before[i]);
   RunOutcome o;
   try {
     o = scene->run(request.quiet ? ProgressSink{} : progress_printer(err), restart);

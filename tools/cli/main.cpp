@@ -3,6 +3,7 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <iostream>
 #include <string>
@@ -43,6 +44,15 @@ void wait_passively_unless_told(char** argv) {
 
 }  // namespace
 
+// CLI11's number checks let NaN through (every comparison with it is false):
+// a time or a duration must be a finite number.
+const CLI::Validator kFinite(
+    [](std::string& text) {
+      const double value = std::strtod(text.c_str(), nullptr);
+      return std::isfinite(value) ? std::string() : "must be a finite number, not " + text;
+    },
+    "FINITE");
+
 int main(int argc, char** argv) {
   wait_passively_unless_told(argv);
   CLI::App app{"mpmvv: verification and validation of a compact MPM/CPDI solver.\n"
@@ -72,12 +82,12 @@ int main(int argc, char** argv) {
                       "save the run's state to FILE.restart (FILE the results file) every SECONDS of wall time and "
                       "when it is stopped early (a signal, --pause-at), for --resume")
       ->type_name("SECONDS")
-      ->check(CLI::PositiveNumber);
+      ->check(kFinite & CLI::PositiveNumber);
   run_cmd->add_option("--pause-at", run.pause_at,
                       "stop before the first step from simulated time T on, as interrupted, saving its state to "
                       "FILE.restart for --resume")
       ->type_name("T")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kFinite & CLI::NonNegativeNumber);
   bool resume = false, resume_if_same = false;
   run_cmd->add_flag("--resume", resume,
                     "go on from FILE.restart when it exists, to the bits of a run that never stopped (refused when it "
@@ -116,7 +126,7 @@ int main(int argc, char** argv) {
                         "a wall time in seconds: say which cases a run of that length (with -j) will not reach, from "
                         "the estimates --list prints")
       ->type_name("SECONDS")
-      ->check(CLI::PositiveNumber);
+      ->check(kFinite & CLI::PositiveNumber);
   suite_cmd->add_option("--only", suite.only,
                         "run (or list) only the cases whose id this regular expression finds, e.g. 'cells=(300|600)-'; "
                         "the others stay as an earlier run left them (pending, or kept)")
@@ -158,7 +168,7 @@ int main(int argc, char** argv) {
       "eval", "Exact fields and body force of a solution at one reference point.\nExit status: 0, or 2 on bad input.");
   eval_cmd->add_option("name", eval.name, "solution name (mpmvv mms list)")->required();
   eval_cmd->add_option("--at", eval.at, "reference point X,Y (R,Z in r-z)")->required()->delimiter(',')->expected(2);
-  eval_cmd->add_option("--time", eval.time, "time t [s]")->required();
+  eval_cmd->add_option("--time", eval.time, "time t [s]")->required()->check(kFinite);
   eval_cmd->add_option("--set", eval.overrides, "override a parameter: --set amplitude=1 (repeatable)")
       ->allow_extra_args(false)
       ->type_name("KEY=VALUE");
@@ -172,7 +182,7 @@ int main(int argc, char** argv) {
   check_cmd->add_option("--tolerance", check.tolerance,
                         "largest allowed relative residual (default: 3 times the differences' own error, estimated "
                         "from two step sizes)")
-      ->check(CLI::PositiveNumber);
+      ->check(kFinite & CLI::PositiveNumber);
   check_cmd->add_option("--seed", check.seed, "random seed");
   check_cmd->add_option("--set", check.overrides, "override a parameter (repeatable)")
       ->allow_extra_args(false)
@@ -193,7 +203,7 @@ int main(int argc, char** argv) {
   drive_cmd->add_option("--rotation", drive.rotation_degrees, "superimposed rotation at the path's end [deg]; 0: none");
   drive_cmd->add_option("--steps", drive.steps, "samples along a standard table's path")->check(CLI::Range(2, 1000000));
   drive_cmd->add_option("--tolerance", drive.tolerance, "largest relative error a check allows")
-      ->check(CLI::PositiveNumber);
+      ->check(kFinite & CLI::PositiveNumber);
   drive_cmd->add_option("--set", drive.overrides, "a material key: --set lambda=1e3 (repeatable; mpmvv run --describe)")
       ->allow_extra_args(false)
       ->type_name("KEY=VALUE");

@@ -29,6 +29,8 @@ namespace mpmvv::app {
 
 namespace {
 
+constexpr double kProbeRoundoff = 1e-12;   // relative: rounding in a probe point the scene placed
+
 class Case final : public SceneCase, private RunObserver {
  public:
   Case(const Config& config, const SceneType& type)
@@ -43,14 +45,24 @@ class Case final : public SceneCase, private RunObserver {
 #ifdef MPMVV_HAVE_CGAL
     if (exact_seeding_ && !setup_.body) throw ConfigError("this scene has no exact body: use seeding = \"centre\"");
 #endif
-    // A probe must be a material point of the body.
+    // A probe must be a material point of the body. A point the scene placed
+    // on a rim (a line's end at the outer radius) can land an ulp outside it
+    // by rounding: one within kProbeRoundoff of the body (relative to its
+    // distance from the origin and the cell size) is on it.
+    const auto on_body = [this](const Vec2& X) {
+      if (setup_.contains(X)) return true;
+      const double nudge = kProbeRoundoff * (X.norm() + setup_.grid.h);
+      for (const Vec2& d : {Vec2(nudge, 0.0), Vec2(-nudge, 0.0), Vec2(0.0, nudge), Vec2(0.0, -nudge)})
+        if (setup_.contains(X + d)) return true;
+      return false;
+    };
     for (const ProbeLine& line : setup_.lines)
       for (const Vec2& X : line.reference)
-        if (!setup_.contains(X))
+        if (!on_body(X))
           throw ConfigError(fmt::format("probe line '{}' has the point ({}, {}) outside the body", line.name,
                                         X.x(), X.y()));
     for (const ProbePoint& point : setup_.points)
-      if (!setup_.contains(point.reference))
+      if (!on_body(point.reference))
         throw ConfigError(fmt::format("probe point '{}' at ({}, {}) lies outside the body", point.name,
                                       point.reference.x(), point.reference.y()));
   }
@@ -233,18 +245,15 @@ class Case final : public SceneCase, private RunObserver {
   std::optional<double> exact_signal_fraction(const std::string& norm, double time) const override {
     return app::exact_signal_fraction(setup_, loop_, norm, time);
   }
+  std::vector<std::string> possible_error_columns() const override { return error_columns(setup_); }
 
  private:
   // The columns of /errors: each line's L1, the particle norms with an exact
   // motion, the scene's own.
   void start_error_table() {
     errors_ = ErrorTable{};
-    for (const ProbeLine& line : setup_.lines) add_error_column("L1_" + line.name);
-    if (setup_.exact_motion)
-      for (const char* name : kParticleNorms) add_error_column(name);
-    for (const std::string& name : setup_.extra_error_names) add_error_column(name);
+    for (const std::string& name : error_columns(setup_)) errors_.add_column(name, error_unit(name, setup_.lines));
   }
-  void add_error_column(const std::string& name) { errors_.add_column(name, error_unit(name, setup_.lines)); }
 
   // The energy at the start, for the balance (monitors.hpp), and the first
   // point of the time-integrated error.

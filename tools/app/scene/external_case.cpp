@@ -163,6 +163,13 @@ class ExternalCase final : public SceneCase {
   std::optional<double> exact_signal_fraction(const std::string& norm, double time) const override {
     return app::exact_signal_fraction(setup_, loop_, norm, time);
   }
+  // The lines' L1 and the particle norms, those the program's output allows (start()).
+  std::vector<std::string> possible_error_columns() const override {
+    std::vector<std::string> names;
+    for (const ProbeLine& line : setup_.lines) names.push_back("L1_" + line.name);
+    names.insert(names.end(), std::begin(kParticleNorms), std::end(kParticleNorms));
+    return names;
+  }
 
   // J's rule where the program gave F, J or volumes; the energy balance is
   // not known (NaN in the samples: judge_health skips it).

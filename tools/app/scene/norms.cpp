@@ -129,6 +129,14 @@ std::vector<std::pair<std::string, double>> settling_norms(const SceneSetup& set
   return norms;
 }
 
+std::vector<std::string> error_columns(const SceneSetup& setup) {
+  std::vector<std::string> names;
+  for (const ProbeLine& line : setup.lines) names.push_back("L1_" + line.name);
+  if (setup.exact_motion) names.insert(names.end(), std::begin(kParticleNorms), std::end(kParticleNorms));
+  names.insert(names.end(), setup.extra_error_names.begin(), setup.extra_error_names.end());
+  return names;
+}
+
 std::optional<double> exact_signal_fraction(const SceneSetup& setup, const TimeLoopOptions& loop,
                                             const std::string& norm, double time) {
   if (!setup.solution) return std::nullopt;

@@ -24,6 +24,11 @@ inline constexpr const char* kParticleNorms[] = {
     "particle_L1",          "particle_L2",          "particle_Linf",         "particle_pressure_L2",
     "particle_deformation_L2", "particle_velocity_L2", "exact_displacement_L2", "particle_relative_L2_integrated"};
 
+// The columns a scene set up as `setup` writes, in order: each probe line's
+// L1_<line>, the particle norms with an exact motion, the scene's own. An
+// external program's run writes those of them its output allows.
+std::vector<std::string> error_columns(const SceneSetup& setup);
+
 // What every column means (eq. 3.1 of 000_1dbcb8acb6dddab9.txt for the lines).
 const char* norm_definitions();
 

@@ -111,6 +111,10 @@ class SceneCase {
   virtual std::optional<double> exact_signal_fraction(const std::string& /*norm*/, double /*time*/) const {
     return std::nullopt;
   }
+  // Every /errors column a run of this case can write (norms.hpp:
+  // error_columns), so that an expectation naming another is refused before
+  // anything runs; empty where the scene cannot say.
+  virtual std::vector<std::string> possible_error_columns() const { return {}; }
 };
 
 struct SceneSetup;  // setup.hpp

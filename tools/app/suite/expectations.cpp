@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "toml_values.hpp"
 
@@ -53,6 +54,50 @@ bool in_tier(const toml::table& e, const std::string& path, const std::string& t
   return std::find(tiers.begin(), tiers.end(), tier) != tiers.end();
 }
 
+// The keys an order is observed against, each setting a size the gate fits
+// ln E against (reports/series.py: REFINED_SIZES, and cells for h).
+constexpr const char* kSizeKeys[] = {"cells", "particles_per_direction", "cfl", "load_steps"};
+
+// Whether case `c` has every key value of `where` (numbers by value).
+bool matches(const SuiteCase& c, const std::vector<Setting>& where) {
+  return std::all_of(where.begin(), where.end(), [&](const Setting& w) {
+    const auto key = c.keys.find(w.key);
+    if (key == c.keys.end()) return false;
+    const Json wanted = json_of(w.value);
+    if (key->second.is_number() && wanted.is_number()) return key->second.get<double>() == wanted.get<double>();
+    return key->second == wanted;
+  });
+}
+
+// The norm must be a column some case it reads writes, and its time (when
+// given) an output time of every such case: each, wrong, is found only after
+// every case ran otherwise.
+void check_norm_and_time(const toml::table& e, const std::string& path, const std::string& study,
+                         const std::vector<const SuiteCase*>& matched) {
+  const toml::node& norm_node = *e.get("norm");
+  const std::string norm = norm_node.as_string()->get();
+  std::vector<std::string> columns;
+  for (const SuiteCase* c : matched)
+    for (const std::string& column : c->error_columns)
+      if (std::find(columns.begin(), columns.end(), column) == columns.end()) columns.push_back(column);
+  if (!columns.empty() && std::find(columns.begin(), columns.end(), norm) == columns.end())
+    throw ConfigError(fmt::format("{}: [[expect]]: study '{}' writes no /errors column '{}'; its columns: {}",
+                                  where_in(path, norm_node), study, norm, fmt::join(columns, ", ")));
+  const toml::node* t = e.get("time");
+  if (!t) return;
+  const double time = t->value<double>().value_or(-1.0);
+  for (const SuiteCase* c : matched) {
+    const auto outputs = c->keys.find("output_times");
+    if (outputs == c->keys.end() || !outputs->second.is_array()) continue;
+    const bool output = std::any_of(outputs->second.begin(), outputs->second.end(), [&](const Json& o) {
+      return o.is_number() && std::abs(o.get<double>() - time) <= 1e-9 * std::max(1.0, std::abs(time));
+    });
+    if (!output)
+      throw ConfigError(fmt::format("{}: [[expect]]: t = {} is not an output time of case '{}' (output_times = {})",
+                                    where_in(path, *t), time, c->id, outputs->second.dump()));
+  }
+}
+
 }  // namespace
 
 void read_expectations(const toml::table& top, const std::string& path, const std::map<std::string, Study>& studies,
@@ -80,9 +125,23 @@ void read_expectations(const toml::table& top, const std::string& path, const st
     auto is_key = [&](const std::string& k) {
       return std::any_of(specs.begin(), specs.end(), [&](const KeySpec& s) { return s.name == k; });
     };
-    if (const toml::node* w = e.get("where")) settings_of(table_at(*w, path, "where"), path, specs, name, "[[expect]] where");
+    std::vector<Setting> where;
+    if (const toml::node* w = e.get("where")) where = settings_of(table_at(*w, path, "where"), path, specs, name, "[[expect]] where");
+    // The cases it reads, in the tier loaded: none is a typo the gate would
+    // find only after every case ran.
+    std::vector<const SuiteCase*> matched;
+    for (const SuiteCase& c : suite.cases)
+      if (c.study == name && matches(c, where)) matched.push_back(&c);
+    if (matched.empty()) {
+      std::vector<std::string> keys;
+      std::vector<Value> values;
+      for (const Setting& w : where) keys.push_back(w.key), values.push_back(w.value);
+      throw ConfigError(fmt::format("{}: [[expect]]: where {} matches no case of study '{}'{}", here,
+                                    row_text(keys, values), name, suite.tier == kCiTier ? " in the ci tier" : ""));
+    }
     const toml::node* norm = e.get("norm");
     if (!norm || !norm->is_string()) throw ConfigError(fmt::format("{}: [[expect]] needs a norm (an /errors column, e.g. \"L1_theta0\")", here));
+    check_norm_and_time(e, path, name, matched);
     // An order with its band, or a bound on the error itself (exact-solution
     // scenes whose error sits at round-off or settling level), or both; or
     // errors at round-off (a patch test: the method reproduces the motion).
@@ -119,6 +178,10 @@ void read_expectations(const toml::table& top, const std::string& path, const st
       if (!r->is_string() || !is_key(r->as_string()->get()))
         throw ConfigError(fmt::format("{}: [[expect]]: 'refine' must name a key of study '{}'", where_in(path, *r), name));
       refine = r->as_string()->get();
+      if (std::find(std::begin(kSizeKeys), std::end(kSizeKeys), refine) == std::end(kSizeKeys))
+        throw ConfigError(fmt::format("{}: [[expect]]: 'refine' = \"{}\" sets no size an order is observed against; "
+                                      "refine one of {}",
+                                      where_in(path, *r), refine, fmt::join(kSizeKeys, ", ")));
     }
     warn_of_a_trivial_read(e, here, *studies.at(name).first, suite.warnings);
     if (const toml::node* l = e.get("levels")) {

@@ -46,12 +46,13 @@ void read_ci_table(const toml::table& top, const std::string& path, Suite& suite
 Suite load_suite(const std::string& path, const std::string& tier) {
   if (tier != kFullTier && tier != kCiTier)
     throw ConfigError(fmt::format("--tier {}: a suite has the tiers '{}' and '{}'", tier, kFullTier, kCiTier));
-  if (!fs::exists(path)) throw ConfigError(fmt::format("{}: no such suite file", path));
-  const toml::table top = parse_toml_file(path);
+  std::string text = read_regular_file(path, "suite file");
+  const toml::table top = parse_toml_text(text, path);
   expect_only(top, {"description", "timeout", "checkpoint_every", "ci", "study", "expect", "reference"}, path,
               "the suite");
   Suite suite;
   suite.file = path;
+  suite.text = std::move(text);
   suite.name = fs::path(path).stem().string();
   suite.tier = tier;
   read_ci_table(top, path, suite);

@@ -110,6 +110,7 @@ void write_manifest(const SuiteDirectory& dir, const Suite& suite) {
   std::strftime(stamp, sizeof stamp, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
   const Json head = {{"suite", suite.name},
                      {"suite_file", suite.file},
+                     {"suite_text", suite.text},
                      {"tier", suite.tier},
                      {"description", suite.description},
                      {"written", stamp},

@@ -348,7 +348,17 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
     if (ranks.first()) fmt::print(err, "mpmvv suite: {}\n", refusal);
     return 2;
   }
-  if (ranks.first()) fs::copy_file(suite.file, dir.root / "suite.toml", fs::copy_options::overwrite_existing, ec);
+  if (ranks.first()) {
+    // Whole or not at all: a full disk must not leave a short suite.toml under its name.
+    try {
+      write_atomically(dir.root / "suite.toml", suite.text);
+    } catch (const std::exception& e) {
+      fmt::print(err, "mpmvv suite: -o {}: cannot write suite.toml: {}\n", dir.root.string(), e.what());
+      refused = 1;
+    }
+  }
+  ranks.share_first(refused);
+  if (refused) return 2;
 
   const std::string prefix = ranks.count() > 1 ? fmt::format("[rank {}] ", ranks.rank()) : "";
   CaseQueue cases(suite, dir, err, request.quiet, prefix);
@@ -370,8 +380,8 @@ int run_suite(const SuiteRequest& request, std::ostream& out, std::ostream& err)
 
   struct sigaction action {};
   action.sa_handler = on_interrupt;
-  sigaction(SIGINT, &action, nullptr);
-  sigaction(SIGTERM, &action, nullptr);
+  // A closed terminal (SIGHUP) stops the suite as SIGTERM does, not silently.
+  for (int signal : {SIGINT, SIGTERM, SIGHUP}) sigaction(signal, &action, nullptr);
 
   const auto suite_start = Clock::now();
   const bool one_rank = ranks.count() == 1;

@@ -30,7 +30,8 @@ std::pair<std::string, Study> expand_study(const toml::node& node, const std::st
   if (!scene_node || !scene_node->is_string())
     throw ConfigError(fmt::format("{}: study '{}' needs a scene (a scene file, relative to the suite)", here, name));
   const std::string scene_file = (base / scene_node->as_string()->get()).lexically_normal().string();
-  if (!fs::exists(scene_file))
+  std::error_code missing;
+  if (!fs::exists(scene_file, missing) && !missing)  // (a loop or a FIFO: load_scene_file names it)
     throw ConfigError(fmt::format("{}: study '{}': no such scene file {}", where_in(path, *scene_node), name, scene_file));
 
   // The scene's own file decides the scene type and its keys.
@@ -134,7 +135,17 @@ std::pair<std::string, Study> expand_study(const toml::node& node, const std::st
     }
   }
 
+  // A bound on the cases, before any is built: a sweep of hundreds of
+  // thousands of cases is a mistake, and listing it alone would take minutes.
+  double count = double(zip_length);
+  for (const Axis& a : sweep) count *= double(a.values.size());
+  if (double(suite.cases.size()) + count > double(kMaxCases))
+    throw ConfigError(fmt::format("{}: study '{}' makes {:.0f} cases ({} before it), more than the {} a suite may "
+                                  "hold: split the sweep into suites",
+                                  here, name, count, suite.cases.size(), kMaxCases));
+
   // The product of the sweep lists, times the zipped tuples.
+  std::vector<int> override_matches(overrides.size(), 0);
   std::unique_ptr<SceneCase> first;
   std::vector<std::size_t> counter(sweep.size(), 0);
   for (bool more = true; more;) {
@@ -158,14 +169,17 @@ std::pair<std::string, Study> expand_study(const toml::node& node, const std::st
         apply(a.key, a.values[z], a.origin);
         c.id += "-" + a.key + "=" + id_part(a.values[z]);
       }
-      for (const Override& ov : overrides) {
+      for (std::size_t k = 0; k < overrides.size(); ++k) {
+        const Override& ov = overrides[k];
         const bool match = std::all_of(ov.where.begin(), ov.where.end(),
                                        [&](const Setting& w) { return same_value(config.value(w.key), w.value); });
-        if (match)
-          for (const Setting& s : ov.set) apply(s.key, s.value, s.origin);
+        if (!match) continue;
+        ++override_matches[k];
+        for (const Setting& s : ov.set) apply(s.key, s.value, s.origin);
       }
       // The scene's own rules between keys, before anything runs.
       std::unique_ptr<SceneCase> built = find_scene_type(config.scene())->build(config);
+      c.error_columns = built->possible_error_columns();
       if (!first) first = std::move(built);
       c.configuration = config.to_toml();
       c.defaults = Config(config.scene(), specs).to_toml();
@@ -191,6 +205,17 @@ std::pair<std::string, Study> expand_study(const toml::node& node, const std::st
       counter[a] = 0;
     }
   }
+  // An override that matches no case is a typo, not a no-op: in the full
+  // tier, where every level runs (a ci tier may leave its levels out).
+  if (suite.tier == kFullTier)
+    for (std::size_t k = 0; k < overrides.size(); ++k)
+      if (override_matches[k] == 0) {
+        std::vector<std::string> keys;
+        std::vector<Value> values;
+        for (const Setting& w : overrides[k].where) keys.push_back(w.key), values.push_back(w.value);
+        throw ConfigError(fmt::format("{}: study '{}': [[study.override]] {} where {} matches none of its cases",
+                                      here, name, k + 1, row_text(keys, values)));
+      }
   return {name, Study{specs, std::move(first), true}};
 }
 

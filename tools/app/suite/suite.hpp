@@ -23,6 +23,7 @@ struct SuiteCase {
   std::string configuration;           // the resolved configuration (TOML), to recognise a finished case
   std::string defaults;                // the scene's defaults in the same form, for results older than a key
   std::map<std::string, Json> keys;  // every resolved scene key: a number, a string or a list of numbers
+  std::vector<std::string> error_columns;  // the /errors columns its run can write (SceneCase::possible_error_columns)
 };
 
 // A suite's tiers (suites/README.md): the full study, and the cheap one every
@@ -30,10 +31,16 @@ struct SuiteCase {
 // `tier` whether it applies there).
 inline constexpr const char* kFullTier = "full";
 inline constexpr const char* kCiTier = "ci";
+// The most cases a suite may make (the largest shipped suite makes a few hundred).
+inline constexpr std::size_t kMaxCases = 10000;
 
 struct Suite {
   std::string name;         // file stem
   std::string file;
+  // The file's text as parsed: written as DIR/suite.toml and recorded in the
+  // manifest ("suite_text"), so the gate can tell the suite.toml beside it
+  // is the one that ran (reports/consistency.py).
+  std::string text;
   std::string description;
   std::string tier = kFullTier;  // the tier loaded: its cases and its expectations only
   // The suite's [ci] table: what its ci tier covers that the others do not,

@@ -1,0 +1,188 @@
+"""What the gate and the report check before they judge a suite output directory:
+that each result is the result of its case (issue: a verdict must never rest on
+data nobody checked).
+
+A suite directory is written by `mpmvv suite`, but anything can have happened
+to it since: a file copied in from another run, a manifest edited by hand, a
+suite.toml of another suite. Every check here names the case (or file) and
+what is wrong, in one line; read_suite (results.py) keeps those lines in
+Suite.problems, drops the results of a case that has one (its numbers are
+not used), and `mpmvv gate` and `mpmvv report` then give FAIL / exit 1 with
+the lines, never a PASS.
+
+Checked per case (manifest entry and results file):
+  * the id is a name (no '/', '\\', control character, '.' or '..');
+  * the results path is relative and resolves inside the directory, and
+    what it names is a regular file (not a FIFO, device or directory);
+  * the manifest's status is one of results.CASE_STATUSES; the file's is one
+    of a results file's (completed, lost, failed, interrupted) and, for a
+    case that ended (completed, failed, lost), the manifest's;
+  * every manifest key has the same value in the file's configuration
+    (numbers to RELATIVE_TOLERANCE);
+  * /errors: time strictly increasing; no error negative or infinite, and
+    none NaN after a value in a completed healthy run (norm_problems).
+Checked per suite: no id and no results file twice, no two cases of one
+study with the same keys, suite.toml the suite the manifest ran.
+"""
+import math
+import re
+import stat
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+RESULT_STATUSES = ("completed", "lost", "failed", "interrupted")
+ENDED = ("completed", "failed", "lost")         # a manifest status read from the results file itself
+RELATIVE_TOLERANCE = 1e-12                       # keys are written from the same doubles
+_NOT_A_NAME = re.compile(r"[/\\\x00-\x1f\x7f]")
+
+
+def id_problem(case_id):
+    """Why `case_id` is not a case name, or ''."""
+    if not case_id or case_id in (".", "..") or _NOT_A_NAME.search(case_id):
+        return f"case id {case_id!r} is not a name (no '/', '\\', control characters, '.' or '..')"
+    return ""
+
+
+def results_path(directory, entry):
+    """(path, problem): where the case's results file is, confined to `directory`;
+    path is None with a one-line problem when the manifest's entry points elsewhere."""
+    relative = entry.get("results", f"cases/{entry['id']}.h5")
+    if not isinstance(relative, str) or not relative:
+        return None, f"'results' is {relative!r}, not a path inside the directory"
+    if Path(relative).is_absolute():
+        return None, f"'results' is the absolute path {relative!r}; a case's file is inside the suite directory"
+    path = Path(directory) / relative
+    try:
+        inside = path.resolve().is_relative_to(Path(directory).resolve())
+    except (OSError, RuntimeError) as error:   # a symlink loop
+        return None, f"'results' {relative!r} cannot be resolved ({error})"
+    if not inside:
+        return None, f"'results' {relative!r} resolves outside the suite directory"
+    try:
+        mode = path.stat().st_mode
+    except FileNotFoundError:
+        return path, ""
+    except OSError as error:
+        return None, f"'results' {relative!r}: {error.strerror}"
+    if not stat.S_ISREG(mode):
+        return None, f"'results' {relative!r} is not a regular file"
+    return path, ""
+
+
+def _same(recorded, expected):
+    if isinstance(expected, bool) or isinstance(recorded, (bool, np.bool_)):
+        return bool(recorded) == expected if isinstance(expected, bool) else False
+    if isinstance(expected, (int, float)):
+        try:
+            value = float(recorded)
+        except (TypeError, ValueError):
+            return False
+        if isinstance(recorded, (str, bytes)):
+            return False                       # a number stored as text is not the number
+        return math.isclose(value, float(expected), rel_tol=RELATIVE_TOLERANCE, abs_tol=0.0) or value == expected
+    if isinstance(expected, list):
+        values = np.atleast_1d(np.asarray(recorded, dtype=object))
+        return len(values) == len(expected) and all(_same(v, e) for v, e in zip(values, expected))
+    return str(recorded) == str(expected)
+
+
+def key_problems(entry, attributes):
+    """The manifest keys whose value the results file's configuration (the
+    resolved keys the run used, TOML in its `configuration` attribute) records
+    differently or not at all. A key the runner found missing and took at its
+    default ("written before K existed" in the manifest's detail) is not one."""
+    keys = entry.get("keys", {})
+    try:
+        configuration = tomllib.loads(str(attributes.get("configuration", "")))
+    except tomllib.TOMLDecodeError as error:
+        return [f"the results file's configuration is not TOML ({error})"]
+    added = str(entry.get("detail", "")).partition("written before ")[2]
+    problems = []
+    for key, value in keys.items():
+        if key not in configuration:
+            if not re.search(rf"\b{re.escape(key)}\b", added):
+                problems.append(f"key '{key}' is {value!r} in the manifest, absent from the results file")
+        elif not _same(configuration[key], value):
+            problems.append(f"key '{key}' is {value!r} in the manifest, {configuration[key]!r} in the results file")
+    return problems
+
+
+def norm_problems(name, times, values, completed_healthy):
+    """Why a column of /errors is not a norm's record, or '': negative or
+    infinite values never are; NaN is the record of no measure (before a
+    quantity can be measured, as a period before its first crossing, or after
+    a run stopped or lost its solution), so in a completed healthy run a NaN
+    after a finite value is damage."""
+    bad = (values < 0.0) | np.isinf(values)
+    if completed_healthy:
+        measured = np.isfinite(values)
+        bad |= np.isnan(values) & (np.cumsum(measured) > 0)
+    if not np.any(bad):
+        return ""
+    first = int(np.argmax(bad))
+    return (f"/errors/{name} is {values[first]:g} at t = {times[first]:g}, not a norm "
+            f"(finite and >= 0{', no NaN after a value in a completed run' if completed_healthy else ''})")
+
+
+def error_problems(results, status):
+    """Problems of /errors: a time axis that does not increase, values that are no norm's."""
+    times = results.error_times
+    problems = []
+    if np.any(~np.isfinite(times)) or np.any(np.diff(times) <= 0):
+        problems.append("/errors/time does not increase strictly")
+    healthy = status == "completed" and results.attributes.get("health") != "solution lost"
+    problems += [p for p in (norm_problems(n, times, v, healthy) for n, v in results.errors.items()) if p]
+    return problems
+
+
+def case_problems(entry, status, results):
+    """One-line problems of a case whose file was read (`results`, results.CaseResults)."""
+    file_status = results.attributes.get("status")
+    if file_status not in RESULT_STATUSES:
+        return [f"the results file's status is {file_status!r}, none of {', '.join(RESULT_STATUSES)}"]
+    problems = []
+    manifest_status = entry.get("status")
+    if manifest_status in ENDED and file_status != manifest_status and \
+            not (manifest_status == "completed" and file_status == "lost"):
+        problems.append(f"the manifest says {manifest_status}, the results file {file_status}")
+    problems += key_problems(entry, results.attributes)
+    problems += error_problems(results, status)
+    return problems
+
+
+def suite_problems(manifest, suite_text, suite_file, cases):
+    """Problems of the directory as a whole: cases twice, suite.toml another suite's."""
+    problems = []
+    seen_ids, seen_paths, seen_keys = set(), {}, {}
+    for case in cases:
+        if case.id in seen_ids:
+            problems.append(f"case '{case.id}' is listed twice in the manifest")
+        seen_ids.add(case.id)
+        try:
+            # (A case whose path was refused has none to share.)
+            where = case.results_path.resolve() if not case.problems else None
+        except (OSError, RuntimeError):
+            where = None
+        if where is not None and where in seen_paths:
+            problems.append(f"cases '{seen_paths[where]}' and '{case.id}' name one results file")
+        elif where is not None:
+            seen_paths[where] = case.id
+        signature = (case.study, repr(sorted(case.keys.items())))
+        if case.keys and signature in seen_keys:
+            problems.append(f"cases '{seen_keys[signature]}' and '{case.id}' of study '{case.study}' have the "
+                            "same keys")
+        seen_keys.setdefault(signature, case.id)
+    recorded = manifest.get("suite_text")
+    if suite_text is not None and isinstance(recorded, str) and recorded != suite_text:
+        problems.append("suite.toml is not the suite file the manifest ran (its text differs from the "
+                        "manifest's 'suite_text')")
+    elif suite_text is not None and recorded is None:
+        # A manifest written before it recorded the suite's text: the studies must at least agree.
+        names = {s.get("name") for s in suite_file.get("study", []) if isinstance(s, dict)}
+        strangers = sorted({c.study for c in cases} - names)
+        if strangers:
+            problems.append(f"suite.toml has no study {', '.join(repr(s) for s in strangers)} of the manifest's "
+                            "cases: it is another suite's")
+    return problems

@@ -1,0 +1,220 @@
+"""Requirements of the checks the gate and the report make before they judge
+(reports/consistency.py): a suite directory whose results are not their cases'
+(a file's status, its keys, a case twice, its time axis, its norms' values,
+a path outside the directory, another suite's suite.toml) never gives PASS:
+`mpmvv gate` exits 1 and `mpmvv report` exits 1, each naming the case and
+what is wrong; a manifest whose expectations cannot be read exits 2 with one
+line. The synthetic suite without a fault passes (exit 0 from both)."""
+import json
+import os
+
+import h5py
+import numpy as np
+import pytest
+
+from . import gate
+from . import report
+from .conftest import SYNTHETIC_SUITE, synthetic_ring_cases, write_suite_directory
+
+CASE = "ring-method=cpdi-cells=64"          # a case the gate's expectation reads
+OTHER = "ring-method=cpdi-cells=32"
+
+
+def manifest_of(directory):
+    return json.loads((directory / "manifest.json").read_text())
+
+
+def rewrite_manifest(directory, change):
+    manifest = manifest_of(directory)
+    change(manifest)
+    (directory / "manifest.json").write_text(json.dumps(manifest))
+
+
+def entry(manifest, case_id=CASE):
+    return next(e for e in manifest["cases"] if e["id"] == case_id)
+
+
+def set_entry(key, value, case_id=CASE):
+    return lambda d: rewrite_manifest(d, lambda m: entry(m, case_id).__setitem__(key, value))
+
+
+def with_results(change, case_id=CASE):
+    def apply(directory):
+        with h5py.File(directory / "cases" / f"{case_id}.h5", "a") as f:
+            change(f)
+    return apply
+
+
+def replace_column(name, values, dtype=float):
+    def change(f):
+        del f["errors"][name]
+        f["errors"][name] = np.asarray(values, dtype=dtype)
+    return with_results(change)
+
+
+def configuration_with(key, value):
+    def change(f):
+        text = f.attrs["configuration"]
+        f.attrs["configuration"] = "\n".join(f"{key} = {value}" if line.startswith(f"{key} =") else line
+                                            for line in text.splitlines()) + "\n"
+    return with_results(change)
+
+
+def duplicate_case(directory):
+    rewrite_manifest(directory, lambda m: m["cases"].append(dict(entry(m))))
+
+
+def a_fifo(directory):
+    path = directory / "cases" / f"{CASE}.h5"
+    path.unlink()
+    os.mkfifo(path)
+
+
+def a_directory(directory):
+    path = directory / "cases" / f"{CASE}.h5"
+    path.unlink()
+    path.mkdir()
+
+
+def a_symlink_loop(directory):
+    path = directory / "cases" / f"{CASE}.h5"
+    path.unlink()
+    path.symlink_to(path.name)
+
+
+def a_link_outside(directory):
+    outside = directory.parent / "outside.h5"
+    path = directory / "cases" / f"{CASE}.h5"
+    path.rename(outside)
+    path.symlink_to(outside)
+
+
+def another_suite_file(directory):
+    (directory / "suite.toml").write_text(SYNTHETIC_SUITE.replace('name = "ring"', 'name = "bar"'))
+
+
+def another_suite_text(directory):
+    rewrite_manifest(directory, lambda m: m.__setitem__("suite_text", "description = 'another'\n"))
+
+
+# (name, how the directory is damaged, what the problem line must say)
+INCONSISTENT = [
+    ("file-without-status", with_results(lambda f: f.attrs.__delitem__("status")), "status is None"),
+    ("file-status-bogus", with_results(lambda f: f.attrs.__setitem__("status", "bogus")), "'bogus'"),
+    ("manifest-status-bogus", set_entry("status", "bogus"), "status 'bogus'"),
+    ("statuses-disagree", with_results(lambda f: f.attrs.__setitem__("status", "failed")),
+     "manifest says completed, the results file failed"),
+    ("cells-differ", configuration_with("cells", "16"), "key 'cells' is 64 in the manifest, 16"),
+    ("cells-as-text", configuration_with("cells", '"64"'), "key 'cells'"),
+    ("key-missing", with_results(lambda f: f.attrs.__setitem__("configuration", "cells = 64\n")), "key 'method'"),
+    ("configuration-not-toml", with_results(lambda f: f.attrs.__setitem__("configuration", "= =")), "not TOML"),
+    ("case-listed-twice", duplicate_case, "listed twice"),
+    ("another-case-file", set_entry("results", f"cases/{OTHER}.h5"), "64 in the manifest, 32 in the results file"),
+    ("time-decreasing", replace_column("time", [1.0, 0.5, 0.25]), "does not increase"),
+    ("negative-error", replace_column("L1_theta0", [-1e-3, 1e-3, 1e-3]), "is -0.001"),
+    ("infinite-error", replace_column("L1_theta0", [1e-3, np.inf, 1e-3]), "is inf"),
+    ("nan-after-a-value", replace_column("L1_theta0", [1e-3, np.nan, 1e-3]), "is nan"),
+    ("text-error-column", replace_column("L1_theta0", [b"1e-3"] * 3, dtype="S8"), "unreadable"),
+    ("two-dimensional-column", replace_column("L1_theta0", np.ones((3, 2))), "unreadable"),
+    ("results-absolute", set_entry("results", "/etc/passwd"), "absolute path"),
+    ("results-outside", set_entry("results", "../../../../etc/passwd"), "outside the suite directory"),
+    ("results-null", set_entry("results", None), "'results' is None"),
+    ("results-a-fifo", a_fifo, "not a regular file"),
+    ("results-a-directory", a_directory, "not a regular file"),
+    ("results-a-symlink-loop", a_symlink_loop, "cannot be resolved"),
+    ("results-linked-outside", a_link_outside, "outside the suite directory"),
+    ("id-a-path", set_entry("id", "../../../x"), "is not a name"),
+    ("completed-without-file", lambda d: (d / "cases" / f"{CASE}.h5").unlink(), "no results file"),
+    ("another-suite-toml", another_suite_file, "another suite's"),
+    ("suite-text-differs", another_suite_text, "not the suite file the manifest ran"),
+]
+
+
+@pytest.fixture
+def suite_directory(tmp_path):
+    return write_suite_directory(tmp_path / "suite", SYNTHETIC_SUITE, synthetic_ring_cases())
+
+
+def outcome(main, arguments, capsys):
+    status = main(arguments)
+    captured = capsys.readouterr()
+    return status, captured.out + captured.err
+
+
+def test_the_undamaged_suite_passes(suite_directory, tmp_path, capsys):
+    """Requirement: the checks find nothing in a directory as mpmvv suite writes it."""
+    assert outcome(gate.main, [str(suite_directory)], capsys)[0] == 0
+    assert outcome(report.main, [str(suite_directory), "-q", "-o", str(tmp_path / "r")], capsys)[0] == 0
+
+
+@pytest.mark.parametrize("name, damage, said", INCONSISTENT, ids=[c[0] for c in INCONSISTENT])
+def test_results_not_their_cases_fail_the_gate_and_the_report(suite_directory, tmp_path, capsys, name, damage,
+                                                             said):
+    """Requirement: every damaged directory gives FAIL (gate exit 1), the report
+    exits 1 and says so first, and the line names the case (or suite.toml) and
+    what is wrong; nothing is read outside the directory."""
+    damage(suite_directory)
+    status, text = outcome(gate.main, [str(suite_directory)], capsys)
+    assert status == 1, text
+    assert said in text, text
+    assert "Traceback" not in text
+    if name not in ("another-suite-toml", "suite-text-differs"):
+        assert "case '" in text
+    status, text = outcome(report.main, [str(suite_directory), "-q", "-o", str(tmp_path / "r")], capsys)
+    assert status == 1, text
+    assert said in text
+    page = (tmp_path / "r" / "report.html").read_text()
+    assert "Verdict: FAIL" in page and "not their cases&#x27;" in page
+    summary = json.loads((tmp_path / "r" / "summary.json").read_text())
+    assert summary["problems"] and summary["gate"]["holds"] is False
+
+
+def test_a_damaged_case_gives_none_of_its_numbers(suite_directory):
+    """Requirement: a case whose results are not its own is read as having none."""
+    from .results import read_suite
+    replace_column("L1_theta0", [-1e-3, 1e-3, 1e-3])(suite_directory)
+    case = next(c for c in read_suite(suite_directory).cases if c.id == CASE)
+    assert case.results is None and case.problems and not case.completed
+
+
+def test_junit_and_json_carry_the_problems(suite_directory, tmp_path, capsys):
+    """Requirement: the CI files fail too: JUnit a failing test case listing the
+    problems, JSON holds = false with them."""
+    set_entry("results", "/etc/passwd")(suite_directory)
+    junit, record = tmp_path / "gate.xml", tmp_path / "gate.json"
+    status, _ = outcome(gate.main, [str(suite_directory), "--junit", str(junit), "--json", str(record)], capsys)
+    assert status == 1
+    assert "results match their cases" in junit.read_text() and "absolute path" in junit.read_text()
+    data = json.loads(record.read_text())
+    assert data["holds"] is False and any("absolute path" in p for p in data["problems"])
+
+
+BAD_EXPECTATIONS = [
+    ({"order": "two"}, "'order' is 'two', not a number"),
+    ({"tolerance": None}, "'tolerance' is null"),
+    ({"where": ["method"]}, "'where' is ['method'], not a table"),
+    ({"levels": 64}, "'levels' is 64, not an array"),
+    ({"max_error": True}, "'max_error' is True, not a number"),
+    ({"study": 5}, "'study' is 5, not text"),
+]
+
+
+@pytest.mark.parametrize("change, said", BAD_EXPECTATIONS, ids=[str(c[0]) for c in BAD_EXPECTATIONS])
+def test_a_manifest_expectation_that_cannot_be_read_is_one_line(suite_directory, tmp_path, capsys, change, said):
+    """Requirement: an expectation edited into something the gate cannot compute
+    with is refused with one line (exit 2), by the gate and the report, never a traceback."""
+    rewrite_manifest(suite_directory, lambda m: m["expectations"][0].update(change))
+    for main, arguments in ((gate.main, [str(suite_directory)]),
+                            (report.main, [str(suite_directory), "-q", "-o", str(tmp_path / "r")])):
+        status, text = outcome(main, arguments, capsys)
+        assert status == 2, text
+        assert said in text and "expectation 1" in text
+        assert len(text.strip().splitlines()) == 1
+
+
+def test_a_fifo_as_manifest_is_refused_at_once(suite_directory, capsys):
+    """Requirement: a FIFO where the manifest should be is not opened (it would block)."""
+    (suite_directory / "manifest.json").unlink()
+    os.mkfifo(suite_directory / "manifest.json")
+    status, text = outcome(gate.main, [str(suite_directory)], capsys)
+    assert status == 2 and "not a regular file" in text
