@@ -21,10 +21,12 @@ Checked per case (manifest entry and results file):
     (numbers to RELATIVE_TOLERANCE);
   * /errors: time strictly increasing; no error negative or infinite, and
     none NaN after a value in a completed healthy run (norm_problems).
-Checked per suite: no id and no results file twice, no two cases of one
+Checked per suite: no suite still writing it, no id and no results file twice, no two cases of one
 study with the same keys, suite.toml the suite the manifest ran.
 """
+import fcntl
 import math
+import os
 import re
 import stat
 import tomllib
@@ -152,9 +154,32 @@ def case_problems(entry, status, results):
     return problems
 
 
-def suite_problems(manifest, suite_text, suite_file, cases):
-    """Problems of the directory as a whole: cases twice, suite.toml another suite's."""
+def being_written(directory):
+    """Whether `mpmvv suite` is writing `directory` now: it holds an exclusive
+    flock on DIR/.lock while it runs (tools/app/suite/run.cpp)."""
+    lock = Path(directory) / ".lock"
+    try:
+        descriptor = os.open(lock, os.O_RDONLY | os.O_NONBLOCK)
+    except OSError:
+        return False
+    try:
+        fcntl.flock(descriptor, fcntl.LOCK_SH | fcntl.LOCK_NB)
+        return False
+    except BlockingIOError:
+        return True
+    except OSError:
+        return False
+    finally:
+        os.close(descriptor)
+
+
+def suite_problems(manifest, suite_text, suite_file, cases, directory):
+    """Problems of the directory as a whole: a suite still writing it, cases
+    twice, suite.toml another suite's."""
     problems = []
+    if being_written(directory):
+        problems.append("mpmvv suite is still writing this directory (it holds .lock): its cases may change; "
+                        "judge it when the suite has ended")
     seen_ids, seen_paths, seen_keys = set(), {}, {}
     for case in cases:
         if case.id in seen_ids:

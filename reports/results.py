@@ -167,7 +167,7 @@ def read_suite(directory):
             raise SuiteDirectoryError(f"{manifest_path}: expectation {number}: {problem}")
     cases = [_read_case(directory, entry) for entry in manifest["cases"]]
     problems = [f"case '{c.id}': {p}" for c in cases for p in c.problems]
-    problems += consistency.suite_problems(manifest, suite_text, suite_file, cases)
+    problems += consistency.suite_problems(manifest, suite_text, suite_file, cases, directory)
     return Suite(
         directory=directory,
         name=str(manifest.get("suite", directory.name)),

@@ -212,6 +212,16 @@ def test_a_manifest_expectation_that_cannot_be_read_is_one_line(suite_directory,
         assert len(text.strip().splitlines()) == 1
 
 
+def test_a_directory_a_suite_is_still_writing_is_not_judged(suite_directory, capsys):
+    """Requirement: while mpmvv suite holds DIR/.lock the gate does not pass it."""
+    import fcntl
+    with open(suite_directory / ".lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        status, text = outcome(gate.main, [str(suite_directory)], capsys)
+    assert status == 1 and "still writing this directory" in text
+    assert outcome(gate.main, [str(suite_directory)], capsys)[0] == 0
+
+
 def test_a_fifo_as_manifest_is_refused_at_once(suite_directory, capsys):
     """Requirement: a FIFO where the manifest should be is not opened (it would block)."""
     (suite_directory / "manifest.json").unlink()

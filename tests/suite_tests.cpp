@@ -266,6 +266,10 @@ TEST(SuiteRunner, OnlyRunsTheSelectedCases) {
   EXPECT_EQ(cases_with_status(manifest, "completed"), 2) << manifest;
   EXPECT_EQ(cases_with_status(manifest, "pending"), 1) << manifest;
   EXPECT_FALSE(fs::exists(dir / "out/cases/square-cells=12.h5"));
+  // A case an earlier run left in error, not selected now, does not fail this run.
+  write(dir / "out/cases/square-cells=12.json",
+        R"({"id": "square-cells=12", "study": "square", "status": "error", "exit_code": 2, "detail": "killed"})");
+  EXPECT_EQ(shell(run + " --only 'cells=8$'"), 0);
   ASSERT_EQ(shell(run), 0);
   manifest = read(dir / "out" / "manifest.json");
   EXPECT_EQ(cases_with_status(manifest, "completed"), 3) << manifest;

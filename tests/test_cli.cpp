@@ -1,6 +1,8 @@
 // The built `mpmvv` command line: bad input exits with status 2 and one line
 // on stderr naming what is wrong, writes no results file, and help exits 0.
 #include <gtest/gtest.h>
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -179,6 +181,33 @@ TEST_F(Cli, FilesThatAreNotFilesAndNanAreRefusedAtOnce) {
     EXPECT_EQ(lines_of(o.err).size(), 1u) << c.arguments << "\n" << o.err;
     EXPECT_FALSE(results_written()) << c.arguments;
   }
+}
+
+// Where the results cannot go is found before the run, not after it: a
+// directory of that name, a name too long for the file system, and a results
+// file another run is writing (its FILE.lock held).
+TEST_F(Cli, AnUnwritableResultsFileIsRefusedBeforeTheRun) {
+  fs::create_directories(directory_ / "taken.h5");
+  const std::string too_long = (directory_ / (std::string(300, 'x') + ".h5")).string();
+  const std::string held = (directory_ / "held.h5").string();
+  const int fd = ::open((held + ".lock").c_str(), O_RDWR | O_CREAT, 0644);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX), 0);
+  const struct {
+    std::string output, says;
+  } corpus[] = {{(directory_ / "taken.h5").string(), "is a directory"},
+                {too_long, "File name too long"},
+                {held, "another mpmvv run is writing this results file now"}};
+  for (const auto& c : corpus) {
+    const Outcome o = mpmvv("run " + ring_scene() + " -q -t 1 --set cells=24 -o " + quoted(c.output));
+    EXPECT_EQ(o.status, 2) << c.output << "\n" << o.err;
+    EXPECT_NE(o.err.find(c.says), std::string::npos) << o.err;
+    EXPECT_EQ(o.out.find("results:"), std::string::npos) << "it ran: " << o.out;
+  }
+  ::close(fd);
+  const Outcome o = mpmvv("run " + ring_scene() + " -q -t 1 --set cells=24 --set end_time=0.01 -o " + quoted(held));
+  EXPECT_EQ(o.status, 0) << o.err;
+  EXPECT_FALSE(fs::exists(held + ".lock")) << "the lock file goes with the run";
 }
 
 // A ring whose outer radius rounds a probe line's end an ulp outside it

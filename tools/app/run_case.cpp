@@ -1,6 +1,8 @@
 #include "run_case.hpp"
 
+#include <fcntl.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <sys/prctl.h>
 #include <unistd.h>
 
@@ -17,6 +19,7 @@
 #include <iostream>
 #include <sstream>
 #include <thread>
+#include <utility>
 
 #include <fmt/format.h>
 #include <fmt/ostream.h>
@@ -181,6 +184,67 @@ ProgressSink progress_printer(std::ostream& err) {
 
 std::string restart_path(const std::string& output) { return output + ".restart"; }
 
+namespace {
+
+// An exclusive lock on a results file's FILE.lock for one run (lock_results),
+// released and removed when the run ends.
+class ResultsLock {
+ public:
+  ResultsLock() = default;
+  ResultsLock(ResultsLock&& o) noexcept : fd_(std::exchange(o.fd_, -1)), path_(std::move(o.path_)) {}
+  ResultsLock& operator=(ResultsLock&& o) noexcept {
+    std::swap(fd_, o.fd_);
+    std::swap(path_, o.path_);
+    return *this;
+  }
+  ~ResultsLock();
+
+ private:
+  friend ResultsLock lock_results(const std::string& output);
+  int fd_ = -1;
+  std::string path_;
+};
+
+ResultsLock::~ResultsLock() {
+  if (fd_ < 0) return;
+  ::unlink(path_.c_str());
+  ::close(fd_);
+}
+
+// What the run will write is known writable before it runs (a directory of
+// that name, a name too long, a folder without write permission: each found
+// at once, not after the simulation), and no other run writes it meanwhile:
+// an exclusive flock on FILE.lock, held to the end (two runs on one results
+// file would each exit 0 and the last rename would win).
+ResultsLock lock_results(const std::string& output) {
+  std::error_code ec;
+  if (fs::is_directory(output, ec))
+    throw ConfigError(fmt::format("-o {}: is a directory; name the results file (.h5) to write", output));
+  ResultsLock lock;
+  lock.path_ = output + ".lock";
+  lock.fd_ = ::open(lock.path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (lock.fd_ < 0)
+    throw ConfigError(fmt::format("-o {}: cannot write there: {}", output, std::strerror(errno)));
+  if (::flock(lock.fd_, LOCK_EX | LOCK_NB) != 0) {
+    ::close(lock.fd_);
+    lock.fd_ = -1;
+    throw ConfigError(fmt::format("-o {}: another mpmvv run is writing this results file now ({} is locked)", output,
+                                  lock.path_));
+  }
+  // The file the results are written to first (then renamed): made and
+  // removed here, or, left by an earlier run, opened for writing and left.
+  const std::string partial = output + ".partial";
+  int probe = ::open(partial.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  const bool made = probe >= 0;
+  if (!made && errno == EEXIST) probe = ::open(partial.c_str(), O_WRONLY | O_CLOEXEC);
+  if (probe < 0) throw ConfigError(fmt::format("-o {}: cannot write {}: {}", output, partial, std::strerror(errno)));
+  ::close(probe);
+  if (made) ::unlink(partial.c_str());
+  return lock;
+}
+
+}  // namespace
+
 std::string describe_configuration(const std::string& scene_file, const std::vector<std::string>& overrides) {
   const Config c = load(scene_file, overrides);
   std::string s = fmt::format("scene = \"{}\"  # {}\n", c.scene(), find_scene_type(c.scene())->summary);
@@ -216,6 +280,7 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
   std::unique_ptr<SceneCase> scene;
   Config config("", {});
   std::string output = request.output;
+  ResultsLock results_lock;
   Fault fault;
   try {
     config = load(request.scene_file, request.overrides);
@@ -230,6 +295,7 @@ int run_case(const RunRequest& request, std::ostream& out, std::ostream& err) {
     std::error_code ec;
     fs::create_directories(parent, ec);
     if (ec) throw ConfigError(fmt::format("-o {}: cannot create directory {}: {}", output, parent.string(), ec.message()));
+    results_lock = lock_results(output);
   } catch (const ConfigError& e) {
     fmt::print(err, "mpmvv run: {}\n", e.what());
     return 2;
