@@ -5,6 +5,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <fmt/format.h>
+
 namespace mpmvv {
 
 namespace {
@@ -137,8 +139,13 @@ RunOutcome run_time_loop(Stepper& stepper, const TimeLoopOptions& options, RunOb
                                           : options.cfl * h / scan.max_signal_speed;
     observer.step_rule(dt);
     if (!std::isfinite(dt) || dt < smallest_step) {
+      // Say which number made it small: the end time asked for, or the
+      // material's signal speed against the cell.
       stop_with("time step collapsed",
-                std::string(stable_rule ? "stable-rule" : "CFL") + " step " + std::to_string(dt) + " s");
+                fmt::format("{} step {:.3g} s is below {:.0e} of end_time = {:.3g} s (the run would take over {:.0e} "
+                            "steps); signal speed {:.3g} m/s over h = {:.3g} m",
+                            stable_rule ? "the stable-rule" : "the CFL", dt, smallest_step / options.end_time,
+                            options.end_time, options.end_time / smallest_step, scan.max_signal_speed, h));
       break;
     }
     if (s.steps == 0) s.dt_first = dt;

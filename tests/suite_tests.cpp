@@ -60,6 +60,24 @@ TEST(SuiteRunner, CrashAndHangAreIsolated) {
     EXPECT_EQ(entry.path().string().find(".partial"), std::string::npos) << entry.path();
 }
 
+// A case past the suite's timeout ends with its external program's whole
+// process group, the program's own background children included: the suite
+// sends the case SIGTERM, and the case ends the group it started.
+TEST(SuiteRunner, ATimedOutExternalProgramLeavesNoProcessBehind) {
+  const fs::path dir = scratch("external-timeout");
+  const std::string marker = "317." + std::to_string(::getpid());
+  const fs::path suite = write(dir / "s.toml", "timeout = 2\n[[study]]\nname = \"slow\"\nscene = \"" + kScenes +
+                                                 "/ring.toml\"\nset = { external_command = \"sleep " + marker +
+                                                 " & sleep " + marker + "\" }\n");
+  const int status = shell(std::string(MPMVV_BINARY) + " suite " + suite.string() + " -j 1 -q -o " +
+                           (dir / "out").string());
+  EXPECT_EQ(status, 1);
+  EXPECT_EQ(cases_with_status(read(dir / "out" / "manifest.json"), "timeout"), 1);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  EXPECT_NE(shell("pgrep -f 'slee[p] " + marker + "' > /dev/null"), 0) << "a sleep " << marker << " survived the suite";
+  shell("pkill -f 'slee[p] " + marker + "'");
+}
+
 // The manifest and each case's file are JSON that a reader parses back to
 // what the suite holds: a description with quotes, a backslash, a tab, a
 // newline and a non-ASCII letter, keys as numbers and strings, a crashed

@@ -17,6 +17,8 @@
 #include <utility>
 #include <vector>
 
+#include <hdf5.h>
+
 #include "solver/io/hdf5.hpp"
 #include "solver/io/state_archive.hpp"
 #include "solver/tensor.hpp"
@@ -191,6 +193,61 @@ TEST(Restart, OnlyTheSameRunGoesOnFromARestartFile) {
             2);
   EXPECT_NE(said.find("explicit runs only"), std::string::npos) << said;
 #endif
+}
+
+namespace {
+
+// The file offset and size of the largest chunked dataset's first chunk in
+// the HDF5 file `path` (H5Dget_chunk_info): where its values lie.
+std::pair<haddr_t, hsize_t> largest_chunk(const std::string& path) {
+  std::pair<haddr_t, hsize_t> best{0, 0};
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  auto visit = [](hid_t object, const char* name, const H5O_info_t* info, void* data) -> herr_t {
+    if (info->type != H5O_TYPE_DATASET) return 0;
+    auto& best = *static_cast<std::pair<haddr_t, hsize_t>*>(data);
+    const hid_t set = H5Dopen2(object, name, H5P_DEFAULT);
+    const hid_t plist = H5Dget_create_plist(set);
+    if (H5Pget_layout(plist) == H5D_CHUNKED) {
+      hsize_t offset[8] = {}, size = 0;
+      unsigned mask = 0;
+      haddr_t address = 0;
+      const hid_t space = H5Dget_space(set);
+      if (H5Dget_chunk_info(set, space, 0, offset, &mask, &address, &size) >= 0 && size > best.second)
+        best = {address, size};
+      H5Sclose(space);
+    }
+    H5Pclose(plist);
+    H5Dclose(set);
+    return 0;
+  };
+  H5Ovisit(file, H5_INDEX_NAME, H5_ITER_NATIVE, visit, &best);
+  H5Fclose(file);
+  return best;
+}
+
+}  // namespace
+
+// A restart file whose values changed on disk (a flipped byte) is refused,
+// not resumed with other numbers: every dataset is under HDF5's Fletcher-32
+// checksum (solver/io/hdf5.cpp).
+TEST(Restart, AFlippedByteIsAnErrorNotANumber) {
+  const std::string ring = "--set cells=24 --set end_time=0.1 --set output_times=[0.1]";
+  const fs::path out = scratch("flipped.h5");
+  const std::string state = out.string() + ".restart";
+  ASSERT_EQ(run("ring.toml", "-t 1 " + ring + " -o " + out.string() + " --pause-at 0.03"), 130);
+  const auto [address, size] = largest_chunk(state);
+  ASSERT_GT(size, 100u) << "no chunked dataset in " << state;
+  {
+    std::fstream file(state, std::ios::in | std::ios::out | std::ios::binary);
+    file.seekg(std::streamoff(address + size / 2));
+    const char byte = char(file.get());
+    file.seekp(std::streamoff(address + size / 2));
+    file.put(char(byte ^ 0x10));
+  }
+  std::string said;
+  EXPECT_EQ(run("ring.toml", "-t 1 " + ring + " -o " + out.string() + " --resume", &said), 2);
+  EXPECT_NE(said.find("cannot be read"), std::string::npos) << said;
+  fs::remove(state);
 }
 
 namespace {

@@ -68,10 +68,27 @@ void untimed(const Handle& creation_properties, const std::string& what) {
   check_status(H5Pset_obj_track_times(creation_properties.get(), false), "H5Pset_obj_track_times", what);
 }
 
+// Rows a chunk holds: the blocks write_rows writes (4 MiB for the widest
+// particle field, 8 doubles a row), so each block fills whole chunks.
+constexpr hsize_t kRowsPerChunk = hsize_t(1) << 16;
+
 Handle create_dataset(hid_t parent, const std::string& name, hid_t type, const Handle& space,
                       const std::string& what) {
   Handle dcpl(check(H5Pcreate(H5P_DATASET_CREATE), "H5Pcreate", what), H5Pclose);
   untimed(dcpl, what);
+  // Every value under HDF5's Fletcher-32 checksum: a flipped bit is an error
+  // on reading, not a different number (a restart promises the bits of an
+  // uninterrupted run; its state is datasets, state_archive.hpp).
+  // The filter needs chunked storage; a scalar or empty dataset has no values
+  // to guard.
+  const int rank = H5Sget_simple_extent_ndims(space.get());
+  std::vector<hsize_t> chunk(std::size_t(std::max(rank, 0)));
+  if (rank > 0) check_status(H5Sget_simple_extent_dims(space.get(), chunk.data(), nullptr), "H5Sget_simple_extent_dims", what);
+  if (rank > 0 && std::all_of(chunk.begin(), chunk.end(), [](hsize_t d) { return d > 0; })) {
+    chunk[0] = std::min(chunk[0], kRowsPerChunk);
+    check_status(H5Pset_chunk(dcpl.get(), rank, chunk.data()), "H5Pset_chunk", what);
+    check_status(H5Pset_fletcher32(dcpl.get()), "H5Pset_fletcher32", what);
+  }
   return Handle(check(H5Dcreate2(parent, name.c_str(), type, space.get(), H5P_DEFAULT, dcpl.get(), H5P_DEFAULT),
                       "H5Dcreate2", what),
                 H5Dclose);
@@ -205,8 +222,8 @@ void Group::write_rows(const std::string& name, const std::vector<hsize_t>& dims
   const hsize_t rows = dims[0];
   hsize_t row_size = 1;
   for (std::size_t k = 1; k < dims.size(); ++k) row_size *= dims[k];
-  // 65,536 rows a block: 4 MiB for the widest particle field (8 doubles a row).
-  constexpr hsize_t kBlock = hsize_t(1) << 16;
+  // A chunk's rows a block (kRowsPerChunk).
+  constexpr hsize_t kBlock = kRowsPerChunk;
   std::vector<double> block(std::size_t(std::min(rows, kBlock) * row_size));
   std::vector<hsize_t> start(dims.size(), 0), count(dims);
   for (hsize_t first = 0; first < rows; first += kBlock) {

@@ -67,9 +67,14 @@ SceneSetup setup(const Config& c) {
   // The motion keeps every radius, so the ring never comes nearer the walls.
   require_two_cells_clearance(c, fmt::format("the ring (outer radius {} m)", p.outer_radius), p.outer_radius, domain,
                               cells);
-  if (p.outer_radius - p.inner_radius < s.grid.h)
-    c.reject("cells", fmt::format("the ring is {} m wide but a cell is {:.4g} m: use more cells",
-                                  p.outer_radius - p.inner_radius, s.grid.h));
+  // h = domain / cells: blame the one the user set (cells when both or neither).
+  if (p.outer_radius - p.inner_radius < s.grid.h) {
+    const bool domain_set = c.origin("domain").source != "default" && c.origin("cells").source == "default";
+    c.reject(domain_set ? "domain" : "cells",
+             fmt::format("the ring is {} m wide but a cell ({} m over {} cells) is {:.4g} m: {}",
+                         p.outer_radius - p.inner_radius, domain, cells, s.grid.h,
+                         domain_set ? "use a smaller domain" : "use more cells"));
+  }
 
   s.solution = mms::make_solution(mms::RingMotion{p}, s.material, p.density, s.geometry);
   s.body_is_annulus(p.inner_radius, p.outer_radius);

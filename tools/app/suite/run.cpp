@@ -42,6 +42,8 @@ namespace {
 volatile sig_atomic_t interrupted = 0;
 void on_interrupt(int) { interrupted = 1; }
 
+constexpr double kTimeoutGrace = 10.0;  // seconds a timed-out case has to end after SIGTERM
+
 // The estimated total of a plan, and with a budget the cases it leaves out.
 void print_plan_total(const Suite& suite, const std::vector<PlannedCase>& plan, int jobs, int threads, double budget,
                       std::ostream& out) {
@@ -218,9 +220,14 @@ class CaseQueue {
       const pid_t r = waitpid(it->pid, &status, WNOHANG);
       const double wall = std::chrono::duration<double>(Clock::now() - it->start).count();
       if (r == 0) {
+        // SIGTERM first: the case ends its external program's own process
+        // group and writes what it computed; SIGKILL if it has not ended
+        // kTimeoutGrace seconds later.
         if (wall > suite_.timeout_seconds && !it->timed_out) {
-          kill(-it->pid, SIGKILL);
+          kill(-it->pid, SIGTERM);
           it->timed_out = true;
+        } else if (it->timed_out && wall > suite_.timeout_seconds + kTimeoutGrace) {
+          kill(-it->pid, SIGKILL);
         }
         ++it;
         continue;
