@@ -89,6 +89,11 @@ void check_norm_and_time(const toml::table& e, const std::string& path, const st
   for (const SuiteCase* c : matched) {
     const auto outputs = c->keys.find("output_times");
     if (outputs == c->keys.end() || !outputs->second.is_array()) continue;
+    // (An output time after the end time is dropped: the run ends first.)
+    const auto end = c->keys.find("end_time");
+    if (end != c->keys.end() && end->second.is_number() && time > end->second.get<double>() * (1.0 + 1e-9))
+      throw ConfigError(fmt::format("{}: [[expect]]: t = {} is after the end time {} of case '{}'",
+                                    where_in(path, *t), time, end->second.get<double>(), c->id));
     const bool output = std::any_of(outputs->second.begin(), outputs->second.end(), [&](const Json& o) {
       return o.is_number() && std::abs(o.get<double>() - time) <= 1e-9 * std::max(1.0, std::abs(time));
     });
