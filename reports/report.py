@@ -292,7 +292,19 @@ def write_report(directory, output=None, progress=None):
     suite = directory if isinstance(directory, Suite) else read_suite(directory)
     output = Path(output) if output else suite.directory / "report"
     figure_directory = output / "figures"
+    made = not figure_directory.exists()
     figure_directory.mkdir(parents=True, exist_ok=True)
+    try:
+        return _write_outputs(suite, output, figure_directory, progress)
+    except OSError:
+        # A full disk or a read-only place: leave no empty folder behind.
+        if made and not any(figure_directory.iterdir()):
+            figure_directory.rmdir()
+        raise
+
+
+def _write_outputs(suite, output, figure_directory, progress):
+    """write_report's outputs, into `output` and its `figures`."""
     # Only the figures an earlier report wrote here go (FIGURE_LIST names
     # them): a file of the user's in the same folder stays.
     listed = figure_directory / FIGURE_LIST
@@ -308,8 +320,9 @@ def write_report(directory, output=None, progress=None):
     written = {"html": output / "report.html", "markdown": output / "report.md",
                "orders": output / "orders.csv", "levels": output / "levels.csv", "gci": output / "gci.csv",
                "summary": output / "summary.json"}
-    written["html"].write_text(render_html(report))
-    written["markdown"].write_text(render_markdown(report, output))
+    # Whole or absent under their names (a full disk leaves no half page).
+    write_atomically(written["html"], render_html(report))
+    write_atomically(written["markdown"], render_markdown(report, output))
     write_orders_csv(report.order_rows, written["orders"])
     write_levels_csv(report.order_rows, written["levels"])
     write_gci_csv(report.gci_rows, written["gci"])

@@ -1,6 +1,7 @@
 """Requirements of what `mpmvv report -o OUT` leaves on disk: it replaces the
 figures an earlier report wrote in OUT/figures and nothing else there (a
-user's own picture stays), and its JSON files are whole or absent."""
+user's own picture stays), its pages and JSON files are whole or absent, and
+a report the disk stopped leaves no empty folder."""
 from . import report
 from .conftest import SYNTHETIC_SUITE, synthetic_ring_cases, write_suite_directory
 
@@ -22,3 +23,22 @@ def test_a_second_report_replaces_its_own_figures_and_keeps_the_users(tmp_path):
     assert stale.read_bytes() != b"an earlier report's figure"
     assert "mine.png" not in (figures / report.FIGURE_LIST).read_text().split()
     assert not list(figures.glob(".*.tmp")) and not list(out.glob(".*.tmp"))
+
+
+def test_a_report_that_cannot_be_written_leaves_no_empty_folder(tmp_path, monkeypatch):
+    """Requirement: a report stopped by the disk (here: ENOSPC while it builds)
+    leaves no empty figures/ behind, and nothing under report.html's name."""
+    import errno
+
+    directory = write_suite_directory(tmp_path / "suite", SYNTHETIC_SUITE, synthetic_ring_cases())
+
+    def full(*_):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(report, "build_report", full)
+    out = tmp_path / "out"
+    try:
+        report.write_report(directory, out)
+    except OSError:
+        pass
+    assert not (out / "figures").exists() and not (out / "report.html").exists()
