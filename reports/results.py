@@ -275,7 +275,9 @@ def _read_case(directory, entry):
     if status not in CASE_STATUSES:
         problems.append(f"the manifest's status {status!r} is none of {', '.join(CASE_STATUSES)}")
         status = "error"
-    if results_path is not None and not problems and results_path.is_file():
+    if problems:
+        pass                                  # a path or name refused: its file is not read
+    elif results_path.is_file():
         try:
             results = read_case_results(results_path)
         except (OSError, KeyError, ValueError, TypeError) as error:
@@ -284,7 +286,7 @@ def _read_case(directory, entry):
                 problems.append(note)
         if results is not None:
             problems += consistency.case_problems(entry, status, results)
-    elif results_path is not None and status not in ("pending",):
+    elif status != "pending":
         note = "no results file"
         if status in consistency.ENDED:
             problems.append(f"the manifest says {status}, and it has no results file")

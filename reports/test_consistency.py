@@ -160,6 +160,8 @@ def test_results_not_their_cases_fail_the_gate_and_the_report(suite_directory, t
     assert "Traceback" not in text
     if name not in ("another-suite-toml", "suite-text-differs"):
         assert "case '" in text
+    if name != "completed-without-file":
+        assert "has no results file" not in text   # a refused path is not also a missing file
     status, text = outcome(report.main, [str(suite_directory), "-q", "-o", str(tmp_path / "r")], capsys)
     assert status == 1, text
     assert said in text
