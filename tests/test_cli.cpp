@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 #include <fcntl.h>
 #include <sys/file.h>
-#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -145,42 +144,6 @@ TEST_F(Cli, DescribeListsResolvedKeys) {
   EXPECT_NE(o.out.find("cells = 40"), std::string::npos) << o.out;
   EXPECT_NE(o.out.find("--set cells=40"), std::string::npos) << o.out;
   EXPECT_NE(o.out.find("output_times = "), std::string::npos) << o.out;
-}
-
-// Files that are not TOML files (a FIFO, which would block a reader, a
-// directory, a symlink loop, which made the filesystem library throw) and
-// numbers that are not numbers (NaN passes every comparison): each refused at
-// once, exit 2, one line naming the file or option; none hangs (each command
-// is given 30 s).
-TEST_F(Cli, FilesThatAreNotFilesAndNanAreRefusedAtOnce) {
-  const fs::path fifo = directory_ / "fifo.toml", loop = directory_ / "loop.toml", five = directory_ / "five.toml";
-  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
-  fs::create_symlink(loop.filename(), loop);
-  std::ofstream(five) << "scene = 5\n";
-  const std::string ring = ring_scene(), fifo_q = quoted(fifo.string()), loop_q = quoted(loop.string());
-  const struct {
-    std::string arguments, says;
-  } corpus[] = {
-      {"run " + fifo_q + " -q -o " + results(), "not a regular file"},
-      {"run " + quoted(directory_.string()) + " -q -o " + results(), "not a regular file"},
-      {"run " + loop_q + " -q -o " + results(), "cannot read this scene file"},
-      {"suite " + fifo_q + " --list", "not a regular file"},
-      {"suite " + loop_q + " --list", "cannot read this suite file"},
-      {"run " + quoted(five.string()) + " -q -o " + results(), "five.toml:1: 'scene' must be the name of a scene"},
-      {"run " + ring + " --pause-at nan -q -o " + results(), "--pause-at"},
-      {"run " + ring + " --checkpoint-every nan -q -o " + results(), "--checkpoint-every"},
-      {"suite " + quoted(std::string(MPMVV_SOURCE_DIR) + "/suites/ring-quick.toml") + " --list --budget nan",
-       "--budget"},
-      {"mms eval ring --at 1,0 --time nan", "--time"},
-      {"results check " + fifo_q, "not a regular file"},
-  };
-  for (const auto& c : corpus) {
-    const Outcome o = mpmvv("timeout 30 " + quoted(MPMVV_BINARY) + " " + c.arguments, /*program=*/false);
-    EXPECT_EQ(o.status, 2) << c.arguments << "\n" << o.err;
-    EXPECT_NE(o.err.find(c.says), std::string::npos) << c.arguments << "\n" << o.err;
-    EXPECT_EQ(lines_of(o.err).size(), 1u) << c.arguments << "\n" << o.err;
-    EXPECT_FALSE(results_written()) << c.arguments;
-  }
 }
 
 // Where the results cannot go is found before the run, not after it: a
