@@ -1,6 +1,7 @@
 """The tables of a report (report.py): cases, measurements, references,
 orders, GCI and expectations, and orders.csv and gci.csv."""
 import csv
+import io
 import math
 from dataclasses import dataclass
 
@@ -9,6 +10,7 @@ import numpy as np
 from . import gate
 from . import norms
 from . import references
+from .gate_files import write_atomically
 from .report_rows import LEVELS_CSV_COLUMNS, ORDERS_CSV_COLUMNS, line_quantities, order_row, study_series
 from .results import lookup_error
 from .series import floor_text
@@ -194,43 +196,44 @@ def order_row_values(r):
             finest.error if finest else ""]
 
 
+def _write_csv(path, header, rows):
+    """A CSV file of `header` and `rows`, whole or absent under `path` (gate_files.write_atomically)."""
+    stream = io.StringIO(newline="")
+    writer = csv.writer(stream)
+    writer.writerow(header)
+    writer.writerows(rows)
+    write_atomically(path, stream.getvalue())
+
+
 def write_orders_csv(rows, path):
-    with open(path, "w", newline="") as stream:
-        writer = csv.writer(stream)
-        writer.writerow([name for name, _ in ORDERS_CSV_COLUMNS])
-        for r in rows:
-            writer.writerow([repr(v) if isinstance(v, float) else v for v in order_row_values(r)])
+    _write_csv(path, [name for name, _ in ORDERS_CSV_COLUMNS],
+               ([repr(v) if isinstance(v, float) else v for v in order_row_values(r)] for r in rows))
+
+
+def _levels_rows(rows):
+    nan = float("nan")
+    for r in rows:
+        row = [r.study, r.series.label, r.norm, r.unit, repr(r.time), r.series.refine]
+        pairwise = [nan] + list(r.pairwise) if r.has_order else [nan] * len(r.levels)
+        relative = _per_level(r, lambda c: c.relative_error)
+        floor = _per_level(r, lambda c: c.relative_floor)
+        settling = _per_level(r, lambda c: c.relative_settling)
+        for k, level in enumerate(r.levels):
+            yield row + [level.value, repr(float(level.h)), repr(float(level.error)), 1, "", repr(float(pairwise[k])),
+                         repr(float(relative[k])), repr(float(floor[k])), repr(float(settling[k]))]
+        for level in r.left_out:
+            yield row + [level.value, repr(float(level.h)), repr(nan), 0, level.reason, *[repr(nan)] * 4]
 
 
 def write_levels_csv(rows, path):
-    nan = float("nan")
-    with open(path, "w", newline="") as stream:
-        writer = csv.writer(stream)
-        writer.writerow([name for name, _ in LEVELS_CSV_COLUMNS])
-        for r in rows:
-            row = [r.study, r.series.label, r.norm, r.unit, repr(r.time), r.series.refine]
-            pairwise = [nan] + list(r.pairwise) if r.has_order else [nan] * len(r.levels)
-            relative = _per_level(r, lambda c: c.relative_error)
-            floor = _per_level(r, lambda c: c.relative_floor)
-            settling = _per_level(r, lambda c: c.relative_settling)
-            for k, level in enumerate(r.levels):
-                writer.writerow(row + [level.value, repr(float(level.h)), repr(float(level.error)), 1, "",
-                                       repr(float(pairwise[k])), repr(float(relative[k])), repr(float(floor[k])),
-                                       repr(float(settling[k]))])
-            for level in r.left_out:
-                writer.writerow(row + [level.value, repr(float(level.h)), repr(nan), 0, level.reason,
-                                       *[repr(nan)] * 4])
+    _write_csv(path, [name for name, _ in LEVELS_CSV_COLUMNS], _levels_rows(rows))
 
 
 def write_gci_csv(rows, path):
-    with open(path, "w", newline="") as stream:
-        writer = csv.writer(stream)
-        writer.writerow(["study", "series", "probe", "quantity", "time", "levels", "f_coarse", "f_medium", "f_fine",
-                         "ratio", "observed_order", "convergence", "extrapolated", "gci_fine", "gci_medium",
-                         "asymptotic_ratio", "exact"])
-        for r in rows:
-            g = r.convergence
-            writer.writerow([r.study, r.series.label, r.probe, r.quantity, repr(r.time),
-                             ";".join(str(v) for v in r.levels), *map(repr, r.values), repr(r.ratio),
-                             repr(g.observed_order), g.convergence, repr(g.extrapolated), repr(g.gci_fine),
-                             repr(g.gci_medium), repr(g.asymptotic_ratio), repr(r.exact)])
+    _write_csv(path, ["study", "series", "probe", "quantity", "time", "levels", "f_coarse", "f_medium", "f_fine",
+                      "ratio", "observed_order", "convergence", "extrapolated", "gci_fine", "gci_medium",
+                      "asymptotic_ratio", "exact"],
+               ([r.study, r.series.label, r.probe, r.quantity, repr(r.time), ";".join(str(v) for v in r.levels),
+                 *map(repr, r.values), repr(r.ratio), repr(r.convergence.observed_order), r.convergence.convergence,
+                 repr(r.convergence.extrapolated), repr(r.convergence.gci_fine), repr(r.convergence.gci_medium),
+                 repr(r.convergence.asymptotic_ratio), repr(r.exact)] for r in rows))

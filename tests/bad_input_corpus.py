@@ -2,7 +2,10 @@
 given a value of the wrong kind and one outside its range, and the files,
 suites and options listed in CORPUS. Each must be refused with exit 2 and one
 line on stderr that names the key (or file, or option), within TIMEOUT
-seconds, with no traceback and no results file left.
+seconds, with no traceback and no results file left. An external program
+whose output is bad (EXTERNAL) is a case that ran: exit 1, its results file
+kept with status "failed", and the one FAILED line names the file or what
+was wrong.
 
 Usage: bad_input_corpus.py MPMVV_BINARY
 """
@@ -12,6 +15,8 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
+
+import h5py
 
 SOURCE = Path(__file__).resolve().parent.parent
 SCENES = SOURCE / "suites" / "scenes"
@@ -165,6 +170,37 @@ CORPUS = [
     ("mms check: tolerance nan", ["mms", "check", "ring", "--tolerance", "nan"], {}, "--tolerance"),
 ]
 
+# (what, external_format, external_command, what the FAILED line must name):
+# programs that fail, hang or write what mpmvv cannot take.
+NAN_POSITION = ("import h5py, sys\nwith h5py.File(sys.argv[1], 'r+') as f:\n"
+                "    for g in f['snapshots'].values():\n        p = g['position']; a = p[...]; a[3, 0] = float('nan'); "
+                "p[...] = a\n")
+EXTERNAL = [
+    ("external: exits 3", "hdf5", "echo broke; exit 3", "exit status 3"),
+    ("external: writes nothing", "hdf5", "true", "no output for t = "),
+    ("external: hangs", "hdf5", "sleep 100", "external_timeout"),
+    ("external: output a FIFO", "hdf5", "mkfifo {output}", "not a regular file"),
+    ("external: output a symlink loop", "hdf5", "ln -s {output} {output}", "cannot be read"),
+    ("external: output a folder", "hdf5", "mkdir {output}", "not a regular file"),
+    ("external: output empty", "hdf5", ": > {output}", "x.external.h5"),
+    ("external: output text", "hdf5", "echo text > {output}", "x.external.h5"),
+    ("external: csv a FIFO", "csv", "mkdir {output}; mkfifo {output}/particles_0.csv", "not a regular file"),
+    ("external: csv without a header", "csv", "mkdir {output}; : > {output}/particles_0.csv", "no header line"),
+    ("external: csv half a group", "csv", "mkdir {output}; printf 'X,Y,x,V0\\n1,0,1,1\\n' > {output}/particles_0.csv",
+     "give all or none"),
+    ("external: csv a word for a number", "csv",
+     "mkdir {output}; printf 'X,Y,x,y,V0\\n1,0,one,0,1\\n' > {output}/particles_0.csv", "particles_0.csv"),
+    ("external: vtk not XML", "vtk", "mkdir {output}; echo '<VTKFile' > {output}/particles_0.vtu", "particles_0.vtu"),
+    ("external: vtk two files for one time", "vtk", "mkdir {output}; : > {output}/particles_0.vtu; "
+     ": > {output}/particles_0.vtk", "one file per output time"),
+    ("external: a position NaN", "hdf5", "{mpmvv} run {scene} -q --set particle_fields=outputs -o {output} && "
+     "/usr/bin/python3 {d}/nan.py {output}", "not a number"),
+]
+
+
+def external_entries(directory):
+    (directory / "nan.py").write_text(NAN_POSITION)
+
 
 def make_files(directory, files):
     for name, text in files.items():
@@ -207,6 +243,37 @@ def main(argv):
                 problems.append("a crash")
             if (directory / "x.h5").exists():
                 problems.append("a results file was written")
+            if problems:
+                failures.append(f"{what}: {'; '.join(problems)}: {said[-300:]}")
+    for what, external_format, program, names in EXTERNAL:
+        count += 1
+        with tempfile.TemporaryDirectory() as temporary:
+            directory = Path(temporary)
+            external_entries(directory)
+            command = [mpmvv, "run", RING, "-q", "--set", "cells=32", "--set", "end_time=0.05", "--set",
+                       "external_timeout=2", "--set", f"external_format={external_format}", "--set",
+                       "external_command=" + program.replace("{d}", str(directory)), "-o", str(directory / "x.h5")]
+            try:
+                ran = subprocess.run(command, capture_output=True, text=True, timeout=TIMEOUT, cwd=directory,
+                                     errors="replace")
+            except subprocess.TimeoutExpired:
+                failures.append(f"{what}: no answer within {TIMEOUT} s")
+                continue
+            said = (ran.stdout + ran.stderr).strip()
+            failed = [line for line in said.splitlines() if "FAILED" in line]
+            problems = []
+            if ran.returncode != 1:
+                problems.append(f"exit {ran.returncode}, not 1")
+            if len(failed) != 1 or names not in failed[0]:
+                problems.append(f"no one FAILED line naming {names!r}")
+            if "Traceback" in said or "terminate called" in said:
+                problems.append("a crash")
+            if not (directory / "x.h5").is_file():
+                problems.append("no results file kept")
+            else:
+                with h5py.File(directory / "x.h5", "r") as results:
+                    if results.attrs.get("status") != "failed":
+                        problems.append(f"status {results.attrs.get('status')!r}, not 'failed'")
             if problems:
                 failures.append(f"{what}: {'; '.join(problems)}: {said[-300:]}")
     print(f"{count} bad inputs, {count - len(failures)} refused as they should be")

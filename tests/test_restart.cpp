@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -247,6 +248,30 @@ TEST(Restart, AFlippedByteIsAnErrorNotANumber) {
   std::string said;
   EXPECT_EQ(run("ring.toml", "-t 1 " + ring + " -o " + out.string() + " --resume", &said), 2);
   EXPECT_NE(said.find("cannot be read"), std::string::npos) << said;
+  fs::remove(state);
+}
+
+// The header's time is an attribute, outside the datasets' checksums: one
+// that does not say what the checksummed state says is refused as well.
+TEST(Restart, AHeaderThatDisagreesWithItsStateIsRefused) {
+  const std::string ring = "--set cells=24 --set end_time=0.1 --set output_times=[0.1]";
+  const fs::path out = scratch("header.h5");
+  const std::string state = out.string() + ".restart";
+  ASSERT_EQ(run("ring.toml", "-t 1 " + ring + " -o " + out.string() + " --pause-at 0.03"), 130);
+  {
+    const hid_t file = H5Fopen(state.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    ASSERT_GE(file, 0);
+    const hid_t time = H5Aopen(file, "time", H5P_DEFAULT);
+    double t = 0.0;
+    H5Aread(time, H5T_NATIVE_DOUBLE, &t);
+    t = std::nextafter(t, 1.0);
+    ASSERT_GE(H5Awrite(time, H5T_NATIVE_DOUBLE, &t), 0);
+    H5Aclose(time);
+    H5Fclose(file);
+  }
+  std::string said;
+  EXPECT_EQ(run("ring.toml", "-t 1 " + ring + " -o " + out.string() + " --resume", &said), 2);
+  EXPECT_NE(said.find("its header says t = "), std::string::npos) << said;
   fs::remove(state);
 }
 

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <system_error>
 #include <limits>
 #include <utility>
 
@@ -107,6 +109,16 @@ void fill_state(OutputState& s, const ArraySource& source, const std::string& wh
 void check_tracers(std::size_t given, std::size_t tracers, const std::string& where) {
   if (given != tracers)
     throw ParticleOutputError(fmt::format("{}: {} tracers, the input file lists {}", where, given, tracers));
+}
+
+bool output_file_written(const std::string& path) {
+  std::error_code error;
+  const std::filesystem::file_status status = std::filesystem::status(path, error);
+  if (status.type() == std::filesystem::file_type::not_found) return false;
+  if (error) throw ParticleOutputError(fmt::format("{}: cannot be read ({})", path, error.message()));
+  if (!std::filesystem::is_regular_file(status))
+    throw ParticleOutputError(fmt::format("{}: not a regular file (a FIFO, device or folder is no output)", path));
+  return true;
 }
 
 }  // namespace mpmvv::app

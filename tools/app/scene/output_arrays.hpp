@@ -45,4 +45,10 @@ double checked_time(double own, const std::vector<double>& requested, std::size_
 // `given` tracers where the input file lists `tracers`.
 void check_tracers(std::size_t given, std::size_t tracers, const std::string& where);
 
+// Whether the program wrote the file `path`: false when nothing is there;
+// throws ParticleOutputError when what is there is not a regular file (a
+// FIFO would block the reader, a directory or device is no output) or
+// cannot be looked at (a symlink loop, a folder without permission).
+bool output_file_written(const std::string& path);
+
 }  // namespace mpmvv::app

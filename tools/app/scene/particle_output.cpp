@@ -147,7 +147,7 @@ double stored_spacing(const h5::Group& g, const std::string& dataset, const std:
 }  // namespace
 
 std::optional<OutputState> ParticleOutput::read_hdf5(std::size_t k, std::size_t tracers) const {
-  if (!fs::exists(path_)) return std::nullopt;
+  if (!output_file_written(path_)) return std::nullopt;
   const h5::File file = h5::File::open_read(path_);
   const h5::Group root = file.root();
   if (!root.has("snapshots")) return std::nullopt;
@@ -255,7 +255,7 @@ CsvTable read_csv_table(const std::string& path) {
 
 std::optional<OutputState> ParticleOutput::read_csv(std::size_t k, std::size_t tracers) const {
   const std::string path = (fs::path(path_) / fmt::format("particles_{}.csv", k)).string();
-  if (!fs::exists(path)) return std::nullopt;
+  if (!output_file_written(path)) return std::nullopt;
   const CsvTable t = read_csv_table(path);
   auto names = [&](const std::string& array) {
     std::vector<std::string> unique;
@@ -290,7 +290,7 @@ std::optional<OutputState> ParticleOutput::read_csv(std::size_t k, std::size_t t
   OutputState s;
   fill_state(s, source, path);
   const std::string tracer_path = (fs::path(path_) / fmt::format("tracers_{}.csv", k)).string();
-  if (fs::exists(tracer_path)) {
+  if (output_file_written(tracer_path)) {
     const CsvTable r = read_csv_table(tracer_path);
     const auto* tx = r.find("x");
     const auto* ty = r.find("y");

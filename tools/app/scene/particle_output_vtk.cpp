@@ -26,7 +26,7 @@ std::optional<std::string> vtk_file_of(const std::string& folder, const std::str
   std::optional<std::string> found;
   for (const char* ext : {".vtu", ".vtp", ".vtk"}) {
     const std::string path = (fs::path(folder) / (stem + ext)).string();
-    if (!fs::exists(path)) continue;
+    if (!output_file_written(path)) continue;
     if (found) throw ParticleOutputError(fmt::format("{} and {}: one file per output time, not two", *found, path));
     found = path;
   }

@@ -46,8 +46,16 @@ void save_restart(const RestartPlan& restart, const LoopState& state, Stepper& s
 void read_restart(const std::string& path, LoopState& loop, Stepper& stepper, const ScenePersist& scene) {
   try {
     const h5::File file = h5::File::open_read(path);
-    StateArchive a = StateArchive::reading(file.root().open_group("state"));
+    const h5::Group root = file.root();
+    StateArchive a = StateArchive::reading(root.open_group("state"));
     a.field("loop", loop);
+    // The header's time and step (printed when the run goes on) are
+    // attributes, outside the datasets' checksums: they must say what the
+    // checksummed state says, or a byte of the file changed.
+    if (root.attribute_double("time") != loop.t || root.attribute_int("steps") != loop.steps)
+      throw std::runtime_error(fmt::format("its header says t = {:.17g} s, step {}, its state t = {:.17g} s, step {}",
+                                           root.attribute_double("time"), root.attribute_int("steps"), loop.t,
+                                           loop.steps));
     a.field("stepper", stepper);
     StateArchive own = a.nested("scene");
     scene(own);

@@ -200,6 +200,7 @@ std::vector<double>& ErrorTable::add_column(const std::string& name, const std::
 }
 
 void print_error_table(std::ostream& out, const ErrorTable& errors) {
+  if (errors.time.empty()) return;  // a case that ended before its first output has no table to print
   fmt::print(out, "{:>8}", "t [s]");
   for (const auto& [name, values] : errors.columns) fmt::print(out, " {:>14}", name);
   fmt::print(out, "\n{:>8}", "");
