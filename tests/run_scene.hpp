@@ -15,17 +15,17 @@
 
 namespace mpmvv::testing {
 
-// Runs `mpmvv run suites/scenes/<scene> -q -t 1 <arguments>` into a scratch
-// results file named `name`, expects its exit status (0: completed; 1: failed
-// or lost) and opens the file.
+// Runs `mpmvv run suites/scenes/<scene> -q -t THREADS <arguments>` into a
+// scratch results file named `name`, expects its exit status (0: completed;
+// 1: failed or lost) and opens the file.
 inline h5::File run_scene(const std::string& scene, const std::string& name, const std::string& arguments,
-                          int expected_exit = 0) {
+                          int expected_exit = 0, int threads = 1) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / "mpmvv-scene-runs";
   std::filesystem::create_directories(dir);
   const std::filesystem::path out = dir / (name + ".h5");
   std::filesystem::remove(out);
   const std::string command = std::string(MPMVV_BINARY) + " run " + MPMVV_SOURCE_DIR + "/suites/scenes/" + scene +
-                              " -q -t 1 " + arguments + " -o " + out.string() + " > /dev/null 2>&1";
+                              " -q -t " + std::to_string(threads) + " " + arguments + " -o " + out.string() + " > /dev/null 2>&1";
   const int status = std::system(command.c_str());
   EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == expected_exit) << command;
   return h5::File::open_read(out.string());
