@@ -90,6 +90,9 @@ CORPUS = [
     ("run: output_times decreasing", ["run", RING, "--set", "output_times=[0.5, 0.1]"], {}, "'output_times'"),
     ("run: ring narrower than a cell", ["run", RING, "--set", "cells=4"], {}, "'cells'"),
     ("run: domain 1e300", ["run", RING, "--set", "domain=1e300"], {}, "'domain'"),
+    ("run: external_names onto another item's own name",
+     ["run", RING, "--set", "external_command=true", "--set", "external_names=reference_position=position"], {},
+     "'external_names'"),
     ("suite: a FIFO", ["suite", "{d}/f.toml", "--list"], {"f.toml": FIFO}, "not a regular file"),
     ("suite: a symlink loop", ["suite", "{d}/l.toml", "--list"], {"l.toml": LOOP}, "cannot read this suite file"),
     ("suite: absent", ["suite", "{d}/absent.toml", "--list"], {}, "no such suite file"),
@@ -168,13 +171,33 @@ CORPUS = [
     ("mms eval: unknown solution", ["mms", "eval", "nope", "--at", "1,0", "--time", "0.5"], {}, "nope"),
     ("mms eval: point outside", ["mms", "eval", "ring", "--at", "5,0", "--time", "0.5"], {}, "outside the body"),
     ("mms check: tolerance nan", ["mms", "check", "ring", "--tolerance", "nan"], {}, "--tolerance"),
+    ("cli: an unknown option for a command", ["--nope"], {}, "unknown option '--nope'"),
+    ("cli: an unknown command under results", ["results", "nope"], {}, "unknown command 'nope'"),
+    ("cli: --budget 0", ["suite", RING.replace("scenes/ring.toml", "ring-quick.toml"), "--list", "--budget", "0"],
+     {}, "--budget: must be a positive number, not 0"),
+    ("mms eval: --at nan", ["mms", "eval", "ring", "--at", "nan,0", "--time", "0.1"], {}, "mms eval: --at"),
+    ("mms eval: --time where the motion overflows", ["mms", "eval", "ring", "--at", "1,0", "--time", "1e308"], {},
+     "--time 1e+308"),
+    ("material drive: a folder as table", ["material", "drive", "--table", "{d}"], {}, "not a regular file"),
+    ("material drive: --rotation inf", ["material", "drive", "--rotation", "inf"], {}, "--rotation"),
+    ("run: --resume with --resume-if-same", ["run", RING, "--resume", "--resume-if-same"], {}, "--resume"),
 ]
 
 # (what, external_format, external_command, what the FAILED line must name):
 # programs that fail, hang or write what mpmvv cannot take.
-NAN_POSITION = ("import h5py, sys\nwith h5py.File(sys.argv[1], 'r+') as f:\n"
-                "    for g in f['snapshots'].values():\n        p = g['position']; a = p[...]; a[3, 0] = float('nan'); "
-                "p[...] = a\n")
+DAMAGE = """import h5py, sys
+item = sys.argv[2]
+with h5py.File(sys.argv[1], 'r+') as f:
+    for g in f['snapshots'].values():
+        if item == 'none':
+            for name in ('reference_position', 'position', 'reference_volume'):
+                del g[name]
+            g['reference_position'] = [[0.0, 0.0]][:0]
+            g['position'] = [[0.0, 0.0]][:0]
+            g['reference_volume'] = [0.0][:0]
+            continue
+        d = g[item]; a = d[...]; a[3, 0] = float('nan'); d[...] = a
+"""
 EXTERNAL = [
     ("external: exits 3", "hdf5", "echo broke; exit 3", "exit status 3"),
     ("external: writes nothing", "hdf5", "true", "no output for t = "),
@@ -194,12 +217,23 @@ EXTERNAL = [
     ("external: vtk two files for one time", "vtk", "mkdir {output}; : > {output}/particles_0.vtu; "
      ": > {output}/particles_0.vtk", "one file per output time"),
     ("external: a position NaN", "hdf5", "{mpmvv} run {scene} -q --set particle_fields=outputs -o {output} && "
-     "/usr/bin/python3 {d}/nan.py {output}", "not a number"),
+     "/usr/bin/python3 {d}/damage.py {output} position", "a particle position is not a number"),
+    ("external: a reference position NaN", "hdf5", "{mpmvv} run {scene} -q --set particle_fields=outputs -o {output} && "
+     "/usr/bin/python3 {d}/damage.py {output} reference_position", "'reference_position' of particle 3 is nan"),
+    ("external: a tracer NaN", "hdf5", "{mpmvv} run {scene} -q --set particle_fields=outputs -o {output} && "
+     "/usr/bin/python3 {d}/damage.py {output} tracer_position", "a tracer position (tracer_position) is not a number"),
+    ("external: no particles", "hdf5", "{mpmvv} run {scene} -q --set particle_fields=outputs -o {output} && "
+     "/usr/bin/python3 {d}/damage.py {output} none", "no particles"),
+    ("external: csv a column twice", "csv",
+     "mkdir {output}; printf 'X,Y,x,y,V0,x\\n1,0,1,0,1,1\\n' > {output}/particles_0.csv", "names column 'x' twice"),
+    ("external: vtk more points declared than held", "vtk",
+     "mkdir {output}; printf '# vtk DataFile Version 3.0\\nx\\nASCII\\nDATASET POLYDATA\\nPOINTS 1000000000 double\\n"
+     "1 0 0\\n' > {output}/particles_0.vtk", "POINTS 1000000000 in a file of"),
 ]
 
 
 def external_entries(directory):
-    (directory / "nan.py").write_text(NAN_POSITION)
+    (directory / "damage.py").write_text(DAMAGE)
 
 
 def make_files(directory, files):

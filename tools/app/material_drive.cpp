@@ -10,6 +10,8 @@
 #include <sstream>
 
 #include <fmt/format.h>
+
+#include "toml_file.hpp"
 #include <fmt/ranges.h>
 
 #include "analytic/f_tables.hpp"
@@ -56,8 +58,7 @@ Path sampled(const std::string& name, const At& at, int steps, std::vector<doubl
 // between the numbers; '#' starts a comment); s increasing, J > 0. F is
 // linear in s between rows.
 Path table_file(const std::string& file, int steps) {
-  std::ifstream in(file);
-  if (!in) throw ConfigError(fmt::format("{}: cannot read the F-table file", file));
+  std::istringstream in(read_regular_file(file, "F-table file"));
   Path p{std::filesystem::path(file).filename().string(), {}, {}};
   std::string line;
   for (int number = 1; std::getline(in, line); ++number) {

@@ -89,6 +89,13 @@ int mms_eval(const MmsEvalRequest& r, std::ostream& out, std::ostream& err) {
   const Vec2 X(r.at[0], r.at[1]);
   const mms::ExactFields f = setup.solution->fields(X, r.time);
   const bool rz = setup.geometry == Geometry::axisymmetric;
+  const bool finite = f.position.allFinite() && f.velocity.allFinite() && f.acceleration.allFinite() &&
+                      f.deformation_gradient.allFinite() && f.cauchy_stress.allFinite() && f.body_force.allFinite();
+  if (!finite) {
+    fmt::print(err, "mpmvv mms eval: --time {}: the fields of '{}' at X = ({}, {}) are not finite numbers there "
+               "(its motion overflows or is not defined at that time)\n", r.time, r.name, X.x(), X.y());
+    return 2;
+  }
   if (r.json) {
     // Doubles to their shortest exact text; a NaN or an infinity as null.
     const Json j = {{"solution", r.name},

@@ -25,7 +25,7 @@ inline std::string read_regular_file(const std::string& path, const char* what) 
     throw ConfigError(fmt::format("{}: cannot read this {}: {}", path, what, ec.message()));
   if (!std::filesystem::exists(status)) throw ConfigError(fmt::format("{}: no such {}", path, what));
   if (!std::filesystem::is_regular_file(status))
-    throw ConfigError(fmt::format("{}: not a regular file; a {} is a TOML file", path, what));
+    throw ConfigError(fmt::format("{}: not a regular file (a FIFO, device or folder is no {})", path, what));
   std::ifstream in(path, std::ios::binary);
   std::ostringstream text;
   text << in.rdbuf();

@@ -53,6 +53,43 @@ const CLI::Validator kFinite(
     },
     "FINITE");
 
+// CLI11's PositiveNumber and NonNegativeNumber say "Value 0 not in range
+// 0.000000 to 1.79769e+308", a range 0 is inside of: say the rule instead.
+const CLI::Validator kPositive(
+    [](std::string& text) {
+      return std::strtod(text.c_str(), nullptr) > 0.0 ? std::string() : "must be a positive number, not " + text;
+    },
+    "POSITIVE");
+const CLI::Validator kNonNegative(
+    [](std::string& text) {
+      return std::strtod(text.c_str(), nullptr) >= 0.0 ? std::string() : "must be 0 or more, not " + text;
+    },
+    "NON-NEGATIVE");
+
+// A word where a command is due that names none ("mpmvv nope", "mpmvv
+// results nope", "mpmvv --nope"): CLI11 would say only that a subcommand is
+// required. Empty when every command named is known.
+std::string unknown_command(const CLI::App& app, int argc, char** argv) {
+  const CLI::App* at = &app;
+  std::string where = "mpmvv";
+  for (int i = 1; i < argc && !at->get_subcommands({}).empty() && at->get_require_subcommand_min() > 0; ++i) {
+    const std::string word = argv[i];
+    if (word == "-h" || word == "--help" || word == "--help-all" || word == "--version") return {};
+    std::string commands;
+    const CLI::App* next = nullptr;
+    for (const CLI::App* sub : at->get_subcommands({})) {
+      if (sub->get_name() == word) next = sub;
+      commands += (commands.empty() ? "" : ", ") + sub->get_name();
+    }
+    if (!next)
+      return fmt::format("{}: unknown {} '{}' (commands: {}; see {} --help)", where,
+                         word.rfind('-', 0) == 0 ? "option" : "command", word, commands, where);
+    where += " " + word;
+    at = next;
+  }
+  return {};
+}
+
 int main(int argc, char** argv) {
   wait_passively_unless_told(argv);
   CLI::App app{"mpmvv: verification and validation of a compact MPM/CPDI solver.\n"
@@ -82,19 +119,20 @@ int main(int argc, char** argv) {
                       "save the run's state to FILE.restart (FILE the results file) every SECONDS of wall time and "
                       "when it is stopped early (a signal, --pause-at), for --resume")
       ->type_name("SECONDS")
-      ->check(kFinite & CLI::PositiveNumber);
+      ->check(kFinite & kPositive);
   run_cmd->add_option("--pause-at", run.pause_at,
                       "stop before the first step from simulated time T on, as interrupted, saving its state to "
                       "FILE.restart for --resume")
       ->type_name("T")
-      ->check(kFinite & CLI::NonNegativeNumber);
+      ->check(kFinite & kNonNegative);
   bool resume = false, resume_if_same = false;
-  run_cmd->add_flag("--resume", resume,
+  CLI::Option* resume_flag = run_cmd->add_flag("--resume", resume,
                     "go on from FILE.restart when it exists, to the bits of a run that never stopped (refused when it "
                     "holds another configuration, build or thread count); start from t = 0 when it does not");
   run_cmd->add_flag("--resume-if-same", resume_if_same,
                     "as --resume, but start from t = 0 when FILE.restart holds another run's state (what a suite "
-                    "passes)");
+                    "passes)")
+      ->excludes(resume_flag);
 
   app.add_subcommand("scenes", "List the scenes and the keys each accepts.");
   app.add_subcommand("paths", "Where this mpmvv finds its reports package and the shipped suites and scene files "
@@ -126,7 +164,7 @@ int main(int argc, char** argv) {
                         "a wall time in seconds: say which cases a run of that length (with -j) will not reach, from "
                         "the estimates --list prints")
       ->type_name("SECONDS")
-      ->check(kFinite & CLI::PositiveNumber);
+      ->check(kFinite & kPositive);
   suite_cmd->add_option("--only", suite.only,
                         "run (or list) only the cases whose id this regular expression finds, e.g. 'cells=(300|600)-'; "
                         "the others stay as an earlier run left them (pending, or kept)")
@@ -167,7 +205,11 @@ int main(int argc, char** argv) {
   CLI::App* eval_cmd = mms_cmd->add_subcommand(
       "eval", "Exact fields and body force of a solution at one reference point.\nExit status: 0, or 2 on bad input.");
   eval_cmd->add_option("name", eval.name, "solution name (mpmvv mms list)")->required();
-  eval_cmd->add_option("--at", eval.at, "reference point X,Y (R,Z in r-z)")->required()->delimiter(',')->expected(2);
+  eval_cmd->add_option("--at", eval.at, "reference point X,Y (R,Z in r-z)")
+      ->required()
+      ->delimiter(',')
+      ->expected(2)
+      ->check(kFinite);
   eval_cmd->add_option("--time", eval.time, "time t [s]")->required()->check(kFinite);
   eval_cmd->add_option("--set", eval.overrides, "override a parameter: --set amplitude=1 (repeatable)")
       ->allow_extra_args(false)
@@ -182,7 +224,7 @@ int main(int argc, char** argv) {
   check_cmd->add_option("--tolerance", check.tolerance,
                         "largest allowed relative residual (default: 3 times the differences' own error, estimated "
                         "from two step sizes)")
-      ->check(kFinite & CLI::PositiveNumber);
+      ->check(kFinite & kPositive);
   check_cmd->add_option("--seed", check.seed, "random seed");
   check_cmd->add_option("--set", check.overrides, "override a parameter (repeatable)")
       ->allow_extra_args(false)
@@ -200,26 +242,19 @@ int main(int argc, char** argv) {
                "check above, 2 bad input.");
   drive_cmd->add_option("--material", drive.materials, "neo-hookean, mooney-rivlin or linear-elastic (repeatable)");
   drive_cmd->add_option("--table", drive.tables, "a standard F-table (mpmvv material tables) or a table file (repeatable)");
-  drive_cmd->add_option("--rotation", drive.rotation_degrees, "superimposed rotation at the path's end [deg]; 0: none");
+  drive_cmd->add_option("--rotation", drive.rotation_degrees, "superimposed rotation at the path's end [deg]; 0: none")
+      ->check(kFinite);
   drive_cmd->add_option("--steps", drive.steps, "samples along a standard table's path")->check(CLI::Range(2, 1000000));
   drive_cmd->add_option("--tolerance", drive.tolerance, "largest relative error a check allows")
-      ->check(kFinite & CLI::PositiveNumber);
+      ->check(kFinite & kPositive);
   drive_cmd->add_option("--set", drive.overrides, "a material key: --set lambda=1e3 (repeatable; mpmvv run --describe)")
       ->allow_extra_args(false)
       ->type_name("KEY=VALUE");
   drive_cmd->add_option("--json", drive.json, "also write the rows and the parameters as JSON to this file");
 
-  if (argc > 1 && argv[1][0] != '-') {
-    bool known = false;
-    std::string commands;
-    for (const CLI::App* sub : app.get_subcommands({})) {
-      known = known || sub->get_name() == argv[1];
-      commands += (commands.empty() ? "" : ", ") + sub->get_name();
-    }
-    if (!known) {
-      fmt::print(stderr, "mpmvv: unknown command '{}' (commands: {}; see mpmvv --help)\n", argv[1], commands);
-      return 2;
-    }
+  if (const std::string unknown = unknown_command(app, argc, argv); !unknown.empty()) {
+    fmt::print(stderr, "{}\n", unknown);
+    return 2;
   }
 
   try {
@@ -232,7 +267,10 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::string where = "mpmvv";
-    for (const CLI::App* sub : app.get_subcommands()) where += " " + sub->get_name();
+    for (const CLI::App* at = &app; !at->get_subcommands().empty();) {
+      at = at->get_subcommands().front();
+      where += " " + at->get_name();
+    }
     fmt::print(stderr, "{}: {} (see {} --help)\n", where, e.what(), where);
     return 2;
   }

@@ -122,12 +122,16 @@ class ExternalCase final : public SceneCase {
       output_spacing_ = k == 0 ? state->output_spacing : std::max(output_spacing_, state->output_spacing);
       o.time_reached = loop_.output_times[k];
       o.outputs_written = k + 1;
-      const bool finite = std::all_of(state->P.position.begin(), state->P.position.end(),
-                                      [](const Vec2& x) { return x.allFinite(); });
+      auto finite = [](const std::vector<Vec2>& x) {
+        return std::all_of(x.begin(), x.end(), [](const Vec2& v) { return v.allFinite(); });
+      };
+      const bool particles_finite = finite(state->P.position), tracers_finite = finite(state->tracers);
       last_ = std::move(state->P);
       last_J_ = std::move(state->J);
-      if (!finite)
-        return finish(o, k, "nan", fmt::format("a particle position is not a number at t = {:.6g} s",
+      if (!particles_finite || !tracers_finite)
+        return finish(o, k, "nan", fmt::format("a {} is not a number at t = {:.6g} s",
+                                               particles_finite ? "tracer position (tracer_position)"
+                                                                : "particle position",
                                                loop_.output_times[k]));
     }
     if (end_.stopped)  // a suite runs an interrupted case again

@@ -81,6 +81,14 @@ void fill_state(OutputState& s, const ArraySource& source, const std::string& wh
   const std::vector<double> X = checked("reference_position", differenced(std::move(reference)), 2);
   const std::vector<double> x = checked("position", differenced(std::move(current)), 2);
   const std::vector<double> V0 = checked("reference_volume", required("reference_volume", 1), 1);
+  if (n == 0) throw ParticleOutputError(fmt::format("{}: no particles ({} has no rows)", where,
+                                                    source.spelled("reference_position")));
+  // The reference positions are the program's input as it took it, not its
+  // result: one that is not a number is malformed output, not a lost run.
+  for (std::size_t i = 0; i < X.size(); ++i)
+    if (!std::isfinite(X[i]))
+      throw ParticleOutputError(fmt::format("{}: {} of particle {} is {}, not a number", where,
+                                            source.spelled("reference_position"), i / 2, X[i]));
   start_state(s, n);
   for (std::size_t p = 0; p < n; ++p) {
     s.P.reference_position[p] = Vec2(X[2 * p], X[2 * p + 1]);

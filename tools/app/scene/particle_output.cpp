@@ -85,6 +85,11 @@ OutputNames parse_output_names(const std::string& text, const std::string& forma
       if (given == file) throw std::invalid_argument(fmt::format("'{}' is the file's name of both {} and {}", file, other, name));
     names[name] = file;
   }
+  // An item left under its own name keeps that name in the file.
+  for (const auto& [name, file] : names)
+    if (file != name && std::find(own.begin(), own.end(), file) != own.end() && !names.count(file))
+      throw std::invalid_argument(fmt::format("'{}' is the file's name of both {} and {} (which keeps its own name)",
+                                              file, name, file));
   return names;
 }
 
@@ -211,6 +216,8 @@ CsvTable read_csv_table(const std::string& path) {
   std::size_t number = 0;
   for (std::string line; std::getline(f, line);) {
     ++number;
+    // A UTF-8 byte order mark before the header, as spreadsheet programs write.
+    if (number == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
     const std::string text = trimmed(line);
     if (text.empty()) continue;
     if (text[0] == '#') {
@@ -229,6 +236,11 @@ CsvTable read_csv_table(const std::string& path) {
     std::stringstream ss(text);
     for (std::string cell; std::getline(ss, cell, ',');) cells.push_back(trimmed(cell));
     if (t.names.empty()) {
+      for (std::size_t a = 0; a < cells.size(); ++a)
+        for (std::size_t b = 0; b < a; ++b)
+          if (cells[a] == cells[b])
+            throw ParticleOutputError(fmt::format("{}:{}: the header names column '{}' twice (columns {} and {})",
+                                                  path, number, cells[a], b + 1, a + 1));
       t.names = cells;
       t.columns.assign(cells.size(), {});
       t.digits.assign(cells.size(), 0);

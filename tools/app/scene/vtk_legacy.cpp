@@ -37,6 +37,7 @@ class LegacyReader {
           throw VtkFileError(fmt::format("{}: DATASET {}: particles are read from POLYDATA or UNSTRUCTURED_GRID", path_, type));
       } else if (key == "POINTS") {
         const std::size_t n = count("POINTS");
+        if (n > text_.size()) throw VtkFileError(fmt::format("{}: POINTS {} in a file of {} bytes", path_, n, text_.size()));
         out.points = values(3 * n, type_of(token()), 3);
       } else if (key == "VERTICES" || key == "LINES" || key == "POLYGONS" || key == "TRIANGLE_STRIPS" || key == "CELLS") {
         const std::size_t n = count(key), size = count(key);
@@ -135,6 +136,12 @@ class LegacyReader {
   // after the header; as `components`-tuples, with their spacing.
   VtkArray values(std::size_t n, ValueType t, std::size_t components = 1) {
     VtkArray a;
+    // A count read from the file bounds nothing: n values must fit in the
+    // bytes left (a text number and its separator take two at least) before
+    // anything is allocated.
+    const std::size_t left = text_.size() - pos_;
+    if (binary_ ? n > left / t.size : n > left / 2 + 1)
+      throw VtkFileError(fmt::format("{}: {} values declared where {} bytes are left", path_, n, left));
     if (!binary_) {
       a.values.resize(n);
       int digits = 0;
@@ -150,7 +157,7 @@ class LegacyReader {
       a.text = true;
     } else {
       line();  // the rest of the header line
-      if (pos_ + n * t.size > text_.size())
+      if (n > (text_.size() - pos_) / t.size)
         throw VtkFileError(fmt::format("{}: the binary data end before {} values", path_, n));
       a = binary_array(text_.substr(pos_, n * t.size), t, true);
       pos_ += n * t.size;

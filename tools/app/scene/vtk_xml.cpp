@@ -27,13 +27,20 @@ class ByteStream {
   ByteStream(const std::string& text, std::size_t pos, bool base64, std::string where)
       : text_(text), pos_(pos), base64_(base64), where_(std::move(where)) {}
 
+  // At most how many bytes are left to read.
+  std::size_t left() const {
+    const std::size_t rest = text_.size() - pos_;
+    return base64_ ? pending_.size() + (rest / 4 + 1) * 3 : rest;  // four characters of base64 make three bytes
+  }
+
   std::string read(std::size_t n) {
     if (!base64_) {
-      if (pos_ + n > text_.size()) throw VtkFileError(fmt::format("{}: the data end before {} more bytes", where_, n));
+      if (n > text_.size() - pos_) throw VtkFileError(fmt::format("{}: the data end before {} more bytes", where_, n));
       std::string out = text_.substr(pos_, n);
       pos_ += n;
       return out;
     }
+    if (n > left()) throw VtkFileError(fmt::format("{}: the data end before {} more bytes", where_, n));
     while (pending_.size() < n) decode_quantum();
     std::string out = pending_.substr(0, n);
     pending_.erase(0, n);
@@ -99,12 +106,20 @@ std::string binary_bytes(ByteStream& in, const XmlLayout& L, const std::string& 
   auto header_value = [&]() { return std::size_t(value_of(in.read(L.header.size).data(), L.header, L.big_endian)); };
   if (!L.compressed) return in.read(header_value());
   const std::size_t blocks = header_value(), block_size = header_value(), last_size = header_value();
+  // A header read from the file bounds nothing: the sizes must fit in what
+  // follows (each block a header integer) before anything is allocated.
+  if (blocks > in.left() / L.header.size)
+    throw VtkFileError(fmt::format("{}: the header declares {} zlib blocks, more than the data can hold", where, blocks));
   std::vector<std::size_t> sizes(blocks);
   for (std::size_t& s : sizes) s = header_value();
   std::string out;
   for (std::size_t b = 0; b < blocks; ++b) {
     const std::string packed = in.read(sizes[b]);
     uLongf size = (b + 1 == blocks && last_size != 0) ? last_size : block_size;
+    // zlib inflates a byte to at most 1032 (its deflate's largest ratio).
+    if (size > 1032 * packed.size() + 64)
+      throw VtkFileError(fmt::format("{}: zlib block {} declares {} bytes inflated from {}, more than zlib can make",
+                                     where, b, size, packed.size()));
     std::string block(size, '\0');
     const int rc = uncompress(reinterpret_cast<Bytef*>(block.data()), &size,
                               reinterpret_cast<const Bytef*>(packed.data()), uLong(packed.size()));
