@@ -117,6 +117,14 @@ CORPUS = [
     ("suite: override matching nothing", ["suite", "{d}/s.toml", "--list"],
      {"s.toml": STUDY + "sweep = { cells = [32, 64] }\n[[study.override]]\nwhere = { cells = 128 }\n"
                         "set = { cfl = 0.2 }\n"}, "matches none of its cases"),
+    ("suite: override where of text for a number", ["suite", "{d}/s.toml", "--list"],
+     {"s.toml": STUDY + "sweep = { cells = [32, 64] }\n[[study.override]]\nwhere = { cells = \"32\" }\n"
+                        "set = { cfl = 0.2 }\n"}, "'cells' takes a number"),
+    ("suite: two overrides set one key of a case", ["suite", "{d}/s.toml", "--list"],
+     {"s.toml": STUDY + "sweep = { cells = [32, 64] }\n[[study.override]]\nwhere = { cells = 32 }\n"
+                        "set = { cfl = 0.2 }\n[[study.override]]\nwhere = {}\nset = { cfl = 0.1 }\n"},
+     "both set 'cfl'"),
+    ("suite: timeout inf", ["suite", "{d}/s.toml", "--list"], {"s.toml": "timeout = inf\n" + STUDY}, "'timeout'"),
     ("suite: override without set", ["suite", "{d}/s.toml", "--list"],
      {"s.toml": STUDY + "[[study.override]]\nwhere = { cells = 64 }\n"}, "needs a 'set'"),
     ("suite: expect unknown study", ["suite", "{d}/s.toml", "--list"],

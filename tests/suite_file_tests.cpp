@@ -164,7 +164,7 @@ TEST(SuiteFile, MistakesNameFileLineAndKey) {
            "/ring.toml\"\nsweep = { cells = [32] }\n",
        "characters long, more than the 244 a file name leaves it"},
       {"[[study]\n", "TOML syntax error"},
-      {"checkpoint_every = -5\n" + study, "s.toml:1: 'checkpoint_every' must be a positive number of seconds"},
+      {"checkpoint_every = -5\n" + study, "s.toml:1: 'checkpoint_every' must be a positive, finite number of seconds"},
   };
   for (const Case& c : cases) {
     const std::string message = config_error(write(dir / "s.toml", c.text));

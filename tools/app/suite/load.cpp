@@ -1,6 +1,7 @@
 // Reading a suite file whole before anything runs (STYLE.md principle 7): its
 // own keys, each [[study]] expanded into cases, its expectations and its
 // references.
+#include <cmath>
 #include <filesystem>
 
 #include <fmt/format.h>
@@ -68,8 +69,8 @@ Suite load_suite(const std::string& path, const std::string& tier) {
     seconds = v && std::holds_alternative<std::int64_t>(*v) ? double(std::get<std::int64_t>(*v))
               : v && std::holds_alternative<double>(*v)     ? std::get<double>(*v)
                                                             : -1.0;
-    if (!(seconds > 0.0))
-      throw ConfigError(fmt::format("{}: '{}' must be a positive number of seconds", where_in(path, *t), key));
+    if (!(seconds > 0.0) || !std::isfinite(seconds))
+      throw ConfigError(fmt::format("{}: '{}' must be a positive, finite number of seconds", where_in(path, *t), key));
   };
   seconds_of("timeout", suite.timeout_seconds);
   seconds_of("checkpoint_every", suite.checkpoint_seconds);

@@ -1,6 +1,7 @@
 #include "study.hpp"
 
 #include <algorithm>
+#include <map>
 #include <filesystem>
 #include <regex>
 
@@ -131,6 +132,14 @@ std::pair<std::string, Study> expand_study(const toml::node& node, const std::st
       if (const toml::node* w = t.get("where")) ov.where = settings_of(table_at(*w, path, "where"), path, specs, scene_config.scene(), "override where");
       if (const toml::node* s = t.get("set")) ov.set = settings_of(table_at(*s, path, "set"), path, specs, scene_config.scene(), "override set");
       if (ov.set.empty()) throw ConfigError(fmt::format("{}: [[study.override]] needs a 'set' table", where_in(path, item)));
+      // A where of text for a number (cells = "24") would match no case and
+      // be called a typo of the value.
+      for (const Setting& w : ov.where)
+        if (const bool text = std::holds_alternative<std::string>(w.value);
+            text != std::holds_alternative<std::string>(scene_config.value(w.key)))
+          throw ConfigError(fmt::format("{}: [[study.override]] where {} = {}: '{}' takes {}", where_in(path, item),
+                                        w.key, text ? "\"" + std::get<std::string>(w.value) + "\"" : as_setting(w.value),
+                                        w.key, text ? "a number" : "text"));
       overrides.push_back(std::move(ov));
     }
   }
@@ -169,13 +178,24 @@ std::pair<std::string, Study> expand_study(const toml::node& node, const std::st
         apply(a.key, a.values[z], a.origin);
         c.id += "-" + a.key + "=" + id_part(a.values[z]);
       }
+      // Two overrides that set one key of a case to two values leave the
+      // reader to guess which holds (the last would).
+      std::map<std::string, std::pair<std::size_t, Value>> set_by;
       for (std::size_t k = 0; k < overrides.size(); ++k) {
         const Override& ov = overrides[k];
         const bool match = std::all_of(ov.where.begin(), ov.where.end(),
                                        [&](const Setting& w) { return same_value(config.value(w.key), w.value); });
         if (!match) continue;
         ++override_matches[k];
-        for (const Setting& s : ov.set) apply(s.key, s.value, s.origin);
+        for (const Setting& s : ov.set) {
+          if (const auto it = set_by.find(s.key); it != set_by.end() && !same_value(it->second.second, s.value))
+            throw ConfigError(fmt::format("{}: study '{}': [[study.override]] {} and {} both set '{}' on case '{}' ({} "
+                                          "and {}): make their where tables exclusive",
+                                          here, name, it->second.first + 1, k + 1, s.key, c.id,
+                                          as_setting(it->second.second), as_setting(s.value)));
+          set_by[s.key] = {k, s.value};
+          apply(s.key, s.value, s.origin);
+        }
       }
       // The scene's own rules between keys, before anything runs.
       std::unique_ptr<SceneCase> built = find_scene_type(config.scene())->build(config);
