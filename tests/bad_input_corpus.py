@@ -9,6 +9,7 @@ was wrong.
 
 Usage: bad_input_corpus.py MPMVV_BINARY
 """
+import concurrent.futures
 import os
 import re
 import subprocess
@@ -210,6 +211,7 @@ EXTERNAL = [
     ("external: exits 3", "hdf5", "echo broke; exit 3", "exit status 3"),
     ("external: writes nothing", "hdf5", "true", "no output for t = "),
     ("external: hangs", "hdf5", "sleep 100", "external_timeout"),
+    ("external: hangs through SIGTERM", "hdf5", "trap '' TERM; sleep 100", "outlived SIGTERM"),
     ("external: output a FIFO", "hdf5", "mkfifo {output}", "not a regular file"),
     ("external: output a symlink loop", "hdf5", "ln -s {output} {output}", "cannot be read"),
     ("external: output a folder", "hdf5", "mkdir {output}", "not a regular file"),
@@ -256,69 +258,74 @@ def make_files(directory, files):
             path.write_text(text)
 
 
+def refused_at_load(mpmvv, what, arguments, files, names):
+    """The problems of one input that must be refused with exit 2 (empty: refused as it should be)."""
+    with tempfile.TemporaryDirectory() as temporary:
+        directory = Path(temporary)
+        make_files(directory, files)
+        command = [mpmvv] + [a.replace("{d}", str(directory)) for a in arguments]
+        if command[1] == "run" and "-o" not in command:
+            command += ["-o", str(directory / "x.h5")]
+        try:
+            ran = subprocess.run(command, capture_output=True, text=True, timeout=TIMEOUT, cwd=directory,
+                                 errors="replace")
+        except subprocess.TimeoutExpired:
+            return f"{what}: no answer within {TIMEOUT} s"
+        said = ran.stderr.strip()
+        problems = []
+        if ran.returncode != 2:
+            problems.append(f"exit {ran.returncode}, not 2")
+        if names not in said:
+            problems.append(f"stderr does not name {names!r}")
+        if len(said.splitlines()) != 1:
+            problems.append(f"{len(said.splitlines())} lines on stderr, not 1")
+        if "Traceback" in said or "terminate called" in said:
+            problems.append("a crash")
+        if (directory / "x.h5").exists():
+            problems.append("a results file was written")
+        return f"{what}: {'; '.join(problems)}: {said[-300:]}" if problems else ""
+
+
+def failed_when_run(mpmvv, what, external_format, program, names):
+    """The problems of one external program whose case must fail with exit 1 (empty: as it should)."""
+    with tempfile.TemporaryDirectory() as temporary:
+        directory = Path(temporary)
+        external_entries(directory)
+        command = [mpmvv, "run", RING, "-q", "--set", "cells=32", "--set", "end_time=0.05", "--set",
+                   "external_timeout=2", "--set", f"external_format={external_format}", "--set",
+                   "external_command=" + program.replace("{d}", str(directory)), "-o", str(directory / "x.h5")]
+        try:
+            ran = subprocess.run(command, capture_output=True, text=True, timeout=TIMEOUT, cwd=directory,
+                                 errors="replace")
+        except subprocess.TimeoutExpired:
+            return f"{what}: no answer within {TIMEOUT} s"
+        said = (ran.stdout + ran.stderr).strip()
+        failed = [line for line in said.splitlines() if "FAILED" in line]
+        problems = []
+        if ran.returncode != 1:
+            problems.append(f"exit {ran.returncode}, not 1")
+        if len(failed) != 1 or names not in failed[0]:
+            problems.append(f"no one FAILED line naming {names!r}")
+        if "Traceback" in said or "terminate called" in said:
+            problems.append("a crash")
+        if not (directory / "x.h5").is_file():
+            problems.append("no results file kept")
+        else:
+            with h5py.File(directory / "x.h5", "r") as results:
+                if results.attrs.get("status") != "failed":
+                    problems.append(f"status {results.attrs.get('status')!r}, not 'failed'")
+        return f"{what}: {'; '.join(problems)}: {said[-300:]}" if problems else ""
+
+
 def main(argv):
     mpmvv = argv[1]
-    failures, count = [], 0
-    for what, arguments, files, names in list(generated(mpmvv)) + CORPUS:
-        count += 1
-        with tempfile.TemporaryDirectory() as temporary:
-            directory = Path(temporary)
-            make_files(directory, files)
-            command = [mpmvv] + [a.replace("{d}", str(directory)) for a in arguments]
-            if command[1] == "run" and "-o" not in command:
-                command += ["-o", str(directory / "x.h5")]
-            try:
-                ran = subprocess.run(command, capture_output=True, text=True, timeout=TIMEOUT, cwd=directory,
-                                     errors="replace")
-            except subprocess.TimeoutExpired:
-                failures.append(f"{what}: no answer within {TIMEOUT} s")
-                continue
-            said = ran.stderr.strip()
-            problems = []
-            if ran.returncode != 2:
-                problems.append(f"exit {ran.returncode}, not 2")
-            if names not in said:
-                problems.append(f"stderr does not name {names!r}")
-            if len(said.splitlines()) != 1:
-                problems.append(f"{len(said.splitlines())} lines on stderr, not 1")
-            if "Traceback" in said or "terminate called" in said:
-                problems.append("a crash")
-            if (directory / "x.h5").exists():
-                problems.append("a results file was written")
-            if problems:
-                failures.append(f"{what}: {'; '.join(problems)}: {said[-300:]}")
-    for what, external_format, program, names in EXTERNAL:
-        count += 1
-        with tempfile.TemporaryDirectory() as temporary:
-            directory = Path(temporary)
-            external_entries(directory)
-            command = [mpmvv, "run", RING, "-q", "--set", "cells=32", "--set", "end_time=0.05", "--set",
-                       "external_timeout=2", "--set", f"external_format={external_format}", "--set",
-                       "external_command=" + program.replace("{d}", str(directory)), "-o", str(directory / "x.h5")]
-            try:
-                ran = subprocess.run(command, capture_output=True, text=True, timeout=TIMEOUT, cwd=directory,
-                                     errors="replace")
-            except subprocess.TimeoutExpired:
-                failures.append(f"{what}: no answer within {TIMEOUT} s")
-                continue
-            said = (ran.stdout + ran.stderr).strip()
-            failed = [line for line in said.splitlines() if "FAILED" in line]
-            problems = []
-            if ran.returncode != 1:
-                problems.append(f"exit {ran.returncode}, not 1")
-            if len(failed) != 1 or names not in failed[0]:
-                problems.append(f"no one FAILED line naming {names!r}")
-            if "Traceback" in said or "terminate called" in said:
-                problems.append("a crash")
-            if not (directory / "x.h5").is_file():
-                problems.append("no results file kept")
-            else:
-                with h5py.File(directory / "x.h5", "r") as results:
-                    if results.attrs.get("status") != "failed":
-                        problems.append(f"status {results.attrs.get('status')!r}, not 'failed'")
-            if problems:
-                failures.append(f"{what}: {'; '.join(problems)}: {said[-300:]}")
-    print(f"{count} bad inputs, {count - len(failures)} refused as they should be")
+    # Each input is a process of its own that mostly waits (to start, on a
+    # file, on a time-out): four at once keep two cores busy.
+    with concurrent.futures.ThreadPoolExecutor(max_workers=4) as pool:
+        runs = [pool.submit(refused_at_load, mpmvv, *entry) for entry in list(generated(mpmvv)) + CORPUS]
+        runs += [pool.submit(failed_when_run, mpmvv, *entry) for entry in EXTERNAL]
+        failures = [r.result() for r in runs if r.result()]
+    print(f"{len(runs)} bad inputs, {len(runs) - len(failures)} refused as they should be")
     for failure in failures:
         print(f"FAIL {failure}")
     return 1 if failures else 0

@@ -209,8 +209,10 @@ void write_external_input(const ExternalFiles& files, const Config& config, cons
 }
 
 std::string ProgramEnd::describe() const {
-  if (timed_out) return fmt::format("ended after {:.0f} s (external_timeout)", seconds);
-  if (stopped) return fmt::format("ended after {:.0f} s: mpmvv was asked to stop", seconds);
+  const std::string killed_text =
+      killed ? fmt::format("; it outlived SIGTERM and was killed {:.0f} s later", seconds - ended_at) : "";
+  if (timed_out) return fmt::format("ended after {:.0f} s (external_timeout){}", ended_at, killed_text);
+  if (stopped) return fmt::format("ended after {:.0f} s: mpmvv was asked to stop{}", ended_at, killed_text);
   if (signal) return fmt::format("killed by signal {} ({})", signal, strsignal(signal));
   return fmt::format("exit status {}", exit_status);
 }
@@ -275,9 +277,11 @@ ProgramEnd run_program(const std::string& command, const std::string& log_path, 
       if (end.timed_out || end.stopped) {
         ::kill(-pid, SIGTERM);
         ending_since = s;
+        end.ended_at = s;
       }
     } else if (s - ending_since > 5.0) {
       ::kill(-pid, SIGKILL);
+      end.killed = true;
     }
     if (tick && s - told >= 1.0) {
       told = s;

@@ -67,6 +67,8 @@ struct ProgramEnd {
   bool timed_out = false;   // killed past the time-out
   bool stopped = false;     // killed because mpmvv was asked to stop (SIGINT, SIGTERM)
   double seconds = 0.0;     // wall time
+  double ended_at = 0.0;    // when it was told to end (SIGTERM), if it was
+  bool killed = false;      // it outlived SIGTERM by 5 s and was killed (SIGKILL)
   std::string log_tail;     // the last lines it printed
   bool succeeded() const { return exit_status == 0 && signal == 0 && !timed_out && !stopped; }
   std::string describe() const;  // "exit status 3", "killed after 60 s (external_timeout)", ...
