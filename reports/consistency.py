@@ -11,18 +11,27 @@ not used), and `mpmvv gate` and `mpmvv report` then give FAIL / exit 1 with
 the lines, never a PASS.
 
 Checked per case (manifest entry and results file):
-  * the id is a name (no '/', '\\', control character, '.' or '..');
+  * the id is a name (no '/', '\\', control character, '.' or '..'), it
+    begins with its study's name, and each of its "-key=value" parts that
+    names a key of the case gives that key's value (tools/app/suite/study.cpp
+    makes the id from the study name and the swept and zipped keys);
+  * the exit code agrees with the status (completed: 0; failed, lost: 0 or 1)
+    and the wall time is a finite number >= 0;
   * the results path is relative and resolves inside the directory, and
     what it names is a regular file (not a FIFO, device or directory);
   * the manifest's status is one of results.CASE_STATUSES; the file's is one
     of a results file's (completed, lost, failed, interrupted) and, for a
     case that ended (completed, failed, lost), the manifest's;
   * every manifest key has the same value in the file's configuration
-    (numbers to RELATIVE_TOLERANCE);
+    (numbers to RELATIVE_TOLERANCE), and every key of the configuration is
+    one of the manifest's;
   * /errors: time strictly increasing; no error negative or infinite, and
     none NaN after a value in a completed healthy run (norm_problems).
 Checked per suite: no suite still writing it, no id and no results file twice, no two cases of one
-study with the same keys, suite.toml the suite the manifest ran.
+study with the same keys, suite.toml the suite the manifest ran, the suite's
+name the stem of its suite_file, the ci tier only on studies that have one.
+The manifest's expectations are checked by results.read_suite against the
+[[expect]] tables suite.toml gives for the tier (suite_expectations).
 """
 import fcntl
 import math
@@ -36,8 +45,10 @@ import numpy as np
 
 RESULT_STATUSES = ("completed", "lost", "failed", "interrupted")
 ENDED = ("completed", "failed", "lost")         # a manifest status read from the results file itself
+NOT_KEYS = ("scene",)                            # in a configuration, not a key (the manifest's entry names it)
 RELATIVE_TOLERANCE = 1e-12                       # keys are written from the same doubles
 _NOT_A_NAME = re.compile(r"[/\\\x00-\x1f\x7f]")
+_CONTROL = re.compile(r"[\x00-\x1f\x7f]")
 
 
 def id_problem(case_id):
@@ -47,18 +58,75 @@ def id_problem(case_id):
     return ""
 
 
+def id_key_problems(entry, overridden=()):
+    """Why the case id is not what its study and keys give, or []: it begins with
+    the study's name, and each "-key=value" part naming a key of the case holds
+    that key's value (as tools/app/suite/study.cpp writes it: the value's text,
+    ' ' and '/' as '_'). A key a [[study.override]] sets (`overridden`) may differ
+    from the id's value, which is the sweep's."""
+    case_id, study, keys = entry["id"], entry["study"], entry.get("keys", {})
+    if case_id != study and not case_id.startswith(study + "-"):
+        return [f"case id {case_id!r} does not begin with its study's name '{study}'"]
+    rest = case_id[len(study):]
+    markers = sorted((m.start(), key) for key in keys
+                     for m in re.finditer(re.escape(f"-{key}="), rest))
+    problems = []
+    for index, (start, key) in enumerate(markers):
+        end = markers[index + 1][0] if index + 1 < len(markers) else len(rest)
+        text = rest[start + len(key) + 2:end]
+        if key not in overridden and not _id_value_is(text, keys[key]):
+            problems.append(f"case id {case_id!r} says {key}={text}, its keys {key} = {keys[key]!r}")
+    return problems
+
+
+def _id_value_is(text, value):
+    if isinstance(value, bool):
+        return text == ("true" if value else "false")
+    if isinstance(value, (int, float)):
+        try:
+            return math.isclose(float(text), float(value), rel_tol=1e-9, abs_tol=0.0)
+        except ValueError:
+            return False
+    if isinstance(value, list):
+        numbers = re.findall(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|nan|inf", text)
+        return len(numbers) == len(value) and all(_id_value_is(n, v) for n, v in zip(numbers, value))
+    return text == str(value).replace(" ", "_").replace("/", "_")
+
+
+def run_problems(entry):
+    """Why the manifest's record of how the case's process ended cannot be, or []:
+    a completed case exited 0, a failed or lost one 0 or 1 (tools/app/suite/
+    case_process.cpp); a wall time is a finite number >= 0."""
+    problems = []
+    status, code = entry.get("status"), entry.get("exit_code")
+    if "exit_code" in entry:
+        if not isinstance(code, int) or isinstance(code, bool):
+            problems.append(f"exit_code is {code!r}, not an integer")
+        elif status == "completed" and code != 0:
+            problems.append(f"the manifest says completed with exit code {code} (a completed run exits 0)")
+        elif status in ("failed", "lost") and code not in (0, 1):
+            problems.append(f"the manifest says {status} with exit code {code} (a run that ended exits 0 or 1)")
+    if "wall_time_s" in entry:
+        wall = entry["wall_time_s"]
+        if not isinstance(wall, (int, float)) or isinstance(wall, bool) or not math.isfinite(wall) or wall < 0:
+            problems.append(f"wall_time_s is {wall!r}, not a time (a finite number >= 0)")
+    return problems
+
+
 def results_path(directory, entry):
     """(path, problem): where the case's results file is, confined to `directory`;
     path is None with a one-line problem when the manifest's entry points elsewhere."""
     relative = entry.get("results", f"cases/{entry['id']}.h5")
     if not isinstance(relative, str) or not relative:
         return None, f"'results' is {relative!r}, not a path inside the directory"
+    if _CONTROL.search(relative):
+        return None, f"'results' {relative!r} holds a control character (a NUL byte or line break): not a path"
     if Path(relative).is_absolute():
         return None, f"'results' is the absolute path {relative!r}; a case's file is inside the suite directory"
     path = Path(directory) / relative
     try:
         inside = path.resolve().is_relative_to(Path(directory).resolve())
-    except (OSError, RuntimeError) as error:   # a symlink loop
+    except (OSError, RuntimeError, ValueError) as error:   # a symlink loop
         return None, f"'results' {relative!r} cannot be resolved ({error})"
     if not inside:
         return None, f"'results' {relative!r} resolves outside the suite directory"
@@ -66,8 +134,8 @@ def results_path(directory, entry):
         mode = path.stat().st_mode
     except FileNotFoundError:
         return path, ""
-    except OSError as error:
-        return None, f"'results' {relative!r}: {error.strerror}"
+    except (OSError, ValueError) as error:
+        return None, f"'results' {relative!r}: {getattr(error, 'strerror', None) or error}"
     if not stat.S_ISREG(mode):
         return None, f"'results' {relative!r} is not a regular file"
     return path, ""
@@ -101,7 +169,8 @@ def key_problems(entry, attributes):
     except tomllib.TOMLDecodeError as error:
         return [f"the results file's configuration is not TOML ({error})"]
     added = str(entry.get("detail", "")).partition("written before ")[2]
-    problems = []
+    problems = [f"key '{key}' is {value!r} in the results file's configuration, absent from the manifest's keys"
+                for key, value in configuration.items() if key not in keys and key not in NOT_KEYS]
     for key, value in keys.items():
         if key not in configuration:
             if not re.search(rf"\b{re.escape(key)}\b", added):
@@ -199,6 +268,12 @@ def suite_problems(manifest, suite_text, suite_file, cases, directory):
             problems.append(f"cases '{seen_keys[signature]}' and '{case.id}' of study '{case.study}' have the "
                             "same keys")
         seen_keys.setdefault(signature, case.id)
+    name, suite_path = manifest.get("suite"), manifest.get("suite_file")
+    if isinstance(suite_path, str) and suite_path and name is not None and name != Path(suite_path).stem:
+        problems.append(f"the manifest's suite is {name!r}, and its suite_file {suite_path!r} names the suite "
+                        f"'{Path(suite_path).stem}' (mpmvv suite names a suite by its file)")
+    if manifest.get("tier") == "ci":
+        problems += _ci_tier_problems(suite_file, cases)
     recorded = manifest.get("suite_text")
     if suite_text is not None and isinstance(recorded, str) and recorded != suite_text:
         problems.append("suite.toml is not the suite file the manifest ran (its text differs from the "
@@ -211,3 +286,63 @@ def suite_problems(manifest, suite_text, suite_file, cases, directory):
             problems.append(f"suite.toml has no study {', '.join(repr(s) for s in strangers)} of the manifest's "
                             "cases: it is another suite's")
     return problems
+
+
+def _ci_tier_problems(suite_file, cases):
+    """Why a manifest of the ci tier is not one suite.toml can run: the suite
+    says it has none ([ci] skip), or a case's study has no `ci` table (such a
+    study does not run in that tier, tools/app/suite/study.cpp)."""
+    ci = suite_file.get("ci")
+    if isinstance(ci, dict) and "skip" in ci:
+        return [f"the manifest's tier is 'ci', and suite.toml has no ci tier ([ci] skip = {ci['skip']!r})"]
+    tables = {s.get("name"): s for s in suite_file.get("study", []) if isinstance(s, dict)}
+    without = [s for s in dict.fromkeys(c.study for c in cases) if s in tables and "ci" not in tables[s]]
+    if without:
+        return [f"the manifest's tier is 'ci', and study {', '.join(repr(s) for s in without)} of suite.toml has "
+                "no `ci` table: it does not run in the ci tier"]
+    return []
+
+
+def suite_expectations(suite_file, tier):
+    """The [[expect]] tables suite.toml gives in `tier`, as mpmvv suite records
+    them in the manifest (tools/app/suite/expectations.cpp: an expectation
+    without `tier` is the full study's; `tier` names a tier or lists them)."""
+    chosen = []
+    for expect in suite_file.get("expect", []):
+        if not isinstance(expect, dict):
+            continue
+        tiers = expect.get("tier", "full")
+        tiers = [tiers] if isinstance(tiers, str) else tiers if isinstance(tiers, list) else []
+        if tier in tiers:
+            chosen.append(expect)
+    return chosen
+
+
+def _equal(a, b):
+    if isinstance(a, bool) or isinstance(b, bool):
+        return type(a) is type(b) and a == b
+    if isinstance(a, (int, float)) and isinstance(b, (int, float)):
+        # (the manifest's numbers are toml++'s JSON text of the same doubles)
+        return a == b or math.isclose(a, b, rel_tol=1e-12, abs_tol=0.0)
+    if isinstance(a, dict) and isinstance(b, dict):
+        return a.keys() == b.keys() and all(_equal(a[k], b[k]) for k in a)
+    if isinstance(a, list) and isinstance(b, list):
+        return len(a) == len(b) and all(_equal(x, y) for x, y in zip(a, b))
+    return type(a) is type(b) and a == b
+
+
+def expectation_problem(recorded, stated, tier):
+    """Why the manifest's expectations (`recorded`) are not the [[expect]]
+    tables suite.toml states for the tier (`stated`, suite_expectations), or ''."""
+    if len(recorded) != len(stated):
+        return (f"records {len(recorded)} expectation(s), and suite.toml's [[expect]] tables give {len(stated)} "
+                f"in the {tier} tier: the expectations are not the suite's")
+    for number, (mine, theirs) in enumerate(zip(recorded, stated), start=1):
+        if _equal(mine, theirs):
+            continue
+        differ = sorted(k for k in set(mine) | set(theirs)
+                        if k not in mine or k not in theirs or not _equal(mine[k], theirs[k]))
+        shown = lambda table, k: repr(table[k]) if k in table else "absent"  # noqa: E731
+        parts = [f"'{k}' is {shown(mine, k)} in the manifest, {shown(theirs, k)} in suite.toml" for k in differ]
+        return f"expectation {number} is not suite.toml's [[expect]] {number}: " + "; ".join(parts)
+    return ""

@@ -44,7 +44,10 @@ numbers are not used, and the gate fails.
 Prints one row per (expectation, series) and a closing line; exit 0 when every
 expectation holds and every result is its case's, 1 otherwise, 2 (one line) when DIR is not a
 readable suite output directory. The [[expect]] tables are the manifest's, which
-`mpmvv suite` checked when it loaded the suite (its one check of them).
+`mpmvv suite` checked when it loaded the suite (its one check of them), and
+which must equal those suite.toml gives for the tier (results.read_suite
+refuses them otherwise). A --json or --junit file that cannot be written is
+exit 2 naming it.
 
 With --junit FILE and --json FILE the same verdicts are also written for CI
 systems (reports/gate_files.py).
@@ -57,7 +60,7 @@ import sys
 from dataclasses import dataclass
 
 from .orders import OrderFit, least_squares_order
-from .results import SuiteDirectoryError, read_suite
+from .results import SuiteDirectoryError, read_suite, require_suite_file
 from .scales import exact_signal_fraction
 from .series import (DEFAULT_REFINE_KEY, Series, floor_kind, floor_text, matches, refinement_series,
                     roundoff_checks, series_levels, size_name, usable)
@@ -311,11 +314,13 @@ def main(argv):
     parser.add_argument("--junit", metavar="FILE", help="also write the verdicts as JUnit XML (reports/gate_files.py)")
     parser.add_argument("--json", metavar="FILE", help="also write the verdicts and their numbers as JSON")
     args = parser.parse_args(argv)
+    for option, path in (("--junit", args.junit), ("--json", args.json)):
+        if path is not None and not path:
+            print(f"mpmvv gate: {option} '': an empty file name; give the file to write", file=sys.stderr)
+            return 2
     try:
         suite = read_suite(args.directory)
-        if not suite.has_suite_file:
-            raise SuiteDirectoryError(f"{suite.directory / 'suite.toml'}: missing; "
-                                      "the gate needs the suite's [[study]] tables")
+        require_suite_file(suite, "the gate")
         if not suite.expectations_recorded:
             raise SuiteDirectoryError(f"{suite.directory / 'manifest.json'}: records no expectations (an mpmvv "
                                       "older than the record wrote it); run the suite again with the same "
@@ -330,7 +335,7 @@ def main(argv):
             try:
                 write(path, suite, verdicts)
             except OSError as error:
-                print(f"mpmvv gate: cannot write {path}: {error.strerror}", file=sys.stderr)
+                print(f"mpmvv gate: cannot write {path}: {error.strerror or error}", file=sys.stderr)
                 return 2
     name = suite.name if suite.tier == "full" else f"{suite.name} ({suite.tier} tier)"
     print_problems(suite, "mpmvv gate")

@@ -15,6 +15,7 @@ that is not finite (no fit, an unusable level) is null.
 import json
 import math
 import os
+import stat
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -77,8 +78,19 @@ def gate_record(suite, verdicts):
 
 
 def write_atomically(path, text):
-    """`text` under `path` whole or not at all (a full disk leaves no partial file under the name)."""
+    """`text` under `path` whole or not at all (a full disk leaves no partial file under the name).
+    A `path` that is not a regular file (a device as /dev/stdout or /dev/full, a
+    FIFO) is written to, never replaced, and a failed write or flush raises OSError."""
     path = Path(path)
+    try:
+        existing = path.stat().st_mode
+    except OSError:
+        existing = None
+    if existing is not None and not stat.S_ISREG(existing) and not stat.S_ISDIR(existing):
+        with open(path, "w", encoding="utf-8") as stream:
+            stream.write(text)
+            stream.flush()
+        return
     temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     try:
         temporary.write_text(text, encoding="utf-8")

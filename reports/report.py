@@ -37,7 +37,7 @@ from .report_rows import LEVELS_CSV_COLUMNS, ORDERS_CSV_COLUMNS, gci_rows, order
 from .report_tables import (case_table, expectation_table, gci_table, measurement_sections, orders_table,
                            reference_sections, write_gci_csv, write_levels_csv,
                            write_orders_csv)
-from .results import Suite, SuiteDirectoryError, read_suite
+from .results import Suite, SuiteDirectoryError, read_suite, require_suite_file
 from .gate_files import write_atomically
 from .summary_file import write_summary
 
@@ -345,6 +345,10 @@ def main(argv):
     parser.add_argument("-o", "--output", metavar="OUT", help="where to write (default DIR/report)")
     parser.add_argument("-q", "--quiet", action="store_true", help="no progress lines on stderr")
     args = parser.parse_args(argv)
+    if args.output is not None and not args.output.strip():
+        print(f"mpmvv report: -o {args.output!r}: an empty directory name; give the directory to write "
+              "(without -o: DIR/report)", file=sys.stderr)
+        return 2
     start, figures_before = clock.perf_counter(), figure_parts.written["figures"]
 
     def progress(done, total, study):
@@ -355,6 +359,7 @@ def main(argv):
 
     try:
         suite = read_suite(args.directory)
+        require_suite_file(suite, "the report")
         written, figure_count = write_report(suite, args.output, None if args.quiet else progress)
     except SuiteDirectoryError as error:
         print(f"mpmvv report: {error}", file=sys.stderr)

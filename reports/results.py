@@ -144,8 +144,10 @@ def read_suite(directory):
     if not directory.is_dir():
         raise SuiteDirectoryError(f"{directory}: no such directory")
     manifest_path = directory / "manifest.json"
+    _confine(directory, manifest_path)
     manifest = _read_manifest(manifest_path)
     suite_path = directory / "suite.toml"
+    _confine(directory, suite_path)
     suite_text = _read_text(suite_path) if suite_path.exists() else None
     suite_file = _parse_suite_file(suite_path, suite_text) if suite_text is not None else {}
     studies = suite_file.get("study", [])
@@ -165,7 +167,14 @@ def read_suite(directory):
         problem = _expectation_problem(expect)
         if problem:
             raise SuiteDirectoryError(f"{manifest_path}: expectation {number}: {problem}")
-    cases = [_read_case(directory, entry) for entry in manifest["cases"]]
+    # ... and they are the ones suite.toml states (a band widened in the
+    # manifest alone, an expectation added or dropped, is refused).
+    if suite_text is not None and "expectations" in manifest:
+        problem = consistency.expectation_problem(expectations, consistency.suite_expectations(suite_file, tier), tier)
+        if problem:
+            raise SuiteDirectoryError(f"{manifest_path}: {problem}")
+    overridden = {s.get("name"): _overridden_keys(s) for s in studies if isinstance(s, dict)}
+    cases = [_read_case(directory, entry, overridden.get(entry["study"], ())) for entry in manifest["cases"]]
     problems = [f"case '{c.id}': {p}" for c in cases for p in c.problems]
     problems += consistency.suite_problems(manifest, suite_text, suite_file, cases, directory)
     return Suite(
@@ -186,12 +195,56 @@ def read_suite(directory):
     )
 
 
+def require_suite_file(suite, program):
+    """Refuse (SuiteDirectoryError) a suite directory without its suite.toml:
+    the gate and the report need its [[study]] tables and check the manifest's
+    expectations against its [[expect]] tables."""
+    if not suite.has_suite_file:
+        raise SuiteDirectoryError(f"{suite.directory / 'suite.toml'}: missing; {program} needs the suite's "
+                                  "[[study]] and [[expect]] tables")
+
+
+def _confine(directory, path):
+    """Refuse `path` (manifest.json, suite.toml) when it, or a symlink it is,
+    resolves outside `directory`: as a case's results file, it is the directory's own."""
+    if not path.is_symlink():
+        return
+    try:
+        inside = path.resolve().is_relative_to(directory.resolve())
+    except (OSError, RuntimeError) as error:
+        raise SuiteDirectoryError(f"{path}: cannot be resolved ({error})") from None
+    if not inside:
+        raise SuiteDirectoryError(f"{path}: a symlink to {path.resolve()}, outside the suite directory; "
+                                  "a suite directory's files are inside it")
+
+
+def _overridden_keys(study):
+    """The keys a study's [[study.override]] tables set (a case's id keeps the swept value)."""
+    overrides = study.get("override", [])
+    return {key for o in overrides if isinstance(o, dict) and isinstance(o.get("set"), dict) for key in o["set"]} \
+        if isinstance(overrides, list) else set()
+
+
+def _no_duplicate_keys(pairs):
+    keys = [key for key, _ in pairs]
+    twice = sorted({key for key in keys if keys.count(key) > 1})
+    if twice:
+        raise ValueError(f"the key {', '.join(repr(k) for k in twice)} is given twice in one object")
+    return dict(pairs)
+
+
+def _no_constant(name):
+    raise ValueError(f"{name} is not JSON (a number there is finite)")
+
+
 def _read_manifest(path):
     if not path.exists() and not path.is_symlink():
         raise SuiteDirectoryError(f"{path}: missing; not a suite output directory (mpmvv suite SUITE -o DIR writes it)")
     try:
-        manifest = json.loads(_read_text(path))
+        manifest = json.loads(_read_text(path), object_pairs_hook=_no_duplicate_keys, parse_constant=_no_constant)
     except json.JSONDecodeError as error:
+        raise SuiteDirectoryError(f"{path}: not valid JSON ({error})") from None
+    except (ValueError, RecursionError) as error:
         raise SuiteDirectoryError(f"{path}: not valid JSON ({error})") from None
     if not isinstance(manifest, dict) or not isinstance(manifest.get("cases"), list):
         raise SuiteDirectoryError(f"{path}: expected an object with a 'cases' array")
@@ -263,11 +316,14 @@ def read_results_file(path):
                 results_path=path, results=results)
 
 
-def _read_case(directory, entry):
+def _read_case(directory, entry, overridden=()):
     """A manifest entry and its results file, checked against each other (consistency.py):
-    a case with a problem keeps it in `problems`, its results None."""
+    a case with a problem keeps it in `problems`, its results None (`overridden`:
+    the keys its study's overrides set)."""
     wall_time = entry.get("wall_time_s")
     problems = [p for p in (consistency.id_problem(entry["id"]),) if p]
+    problems += consistency.id_key_problems(entry, overridden) if not problems else []
+    problems += consistency.run_problems(entry)
     results_path, path_problem = consistency.results_path(directory, entry)
     problems += [path_problem] if path_problem else []
     results, note = None, ""

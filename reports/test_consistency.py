@@ -97,6 +97,10 @@ def another_suite_text(directory):
     rewrite_manifest(directory, lambda m: m.__setitem__("suite_text", "description = 'another'\n"))
 
 
+def drop_key(key, case_id=CASE):
+    return lambda d: rewrite_manifest(d, lambda m: entry(m, case_id)["keys"].pop(key))
+
+
 # (name, how the directory is damaged, what the problem line must say)
 INCONSISTENT = [
     ("file-without-status", with_results(lambda f: f.attrs.__delitem__("status")), "status is None"),
@@ -127,7 +131,20 @@ INCONSISTENT = [
     ("completed-without-file", lambda d: (d / "cases" / f"{CASE}.h5").unlink(), "no results file"),
     ("another-suite-toml", another_suite_file, "another suite's"),
     ("suite-text-differs", another_suite_text, "not the suite file the manifest ran"),
+    # A hostile-user corpus (#431, #378, #384, #385, #396, #429):
+    ("results-with-nul", set_entry("results", "cases/x.h5\u0000junk"), "holds a control character"),
+    ("id-not-its-keys", set_entry("id", "ring-method=cpdi-cells=99"), "says cells=99, its keys cells = 64"),
+    ("id-not-its-study", set_entry("id", "bar-method=cpdi-cells=64"), "does not begin with its study's name"),
+    ("completed-with-a-crash-exit", set_entry("exit_code", 139), "completed with exit code 139"),
+    ("exit-code-not-a-number", set_entry("exit_code", "0"), "exit_code is '0', not an integer"),
+    ("wall-time-negative", set_entry("wall_time_s", -1.0), "wall_time_s is -1.0, not a time"),
+    ("wall-time-text", set_entry("wall_time_s", "1"), "wall_time_s is '1', not a time"),
+    ("key-dropped-from-manifest", drop_key("amplitude"),
+     "key 'amplitude' is 0.5 in the results file's configuration, absent from the manifest's keys"),
+    ("suite-named-otherwise", lambda d: rewrite_manifest(d, lambda m: m.__setitem__("suite", "other")),
+     "the manifest's suite is 'other', and its suite_file 'suites/synthetic.toml' names the suite 'synthetic'"),
 ]
+NOT_A_CASE = ("another-suite-toml", "suite-text-differs", "suite-named-otherwise")
 
 
 @pytest.fixture
@@ -158,7 +175,7 @@ def test_results_not_their_cases_fail_the_gate_and_the_report(suite_directory, t
     assert status == 1, text
     assert said in text, text
     assert "Traceback" not in text
-    if name not in ("another-suite-toml", "suite-text-differs"):
+    if name not in NOT_A_CASE:
         assert "case '" in text
     if name != "completed-without-file":
         assert "has no results file" not in text   # a refused path is not also a missing file
@@ -230,3 +247,86 @@ def test_a_fifo_as_manifest_is_refused_at_once(suite_directory, capsys):
     os.mkfifo(suite_directory / "manifest.json")
     status, text = outcome(gate.main, [str(suite_directory)], capsys)
     assert status == 2 and "not a regular file" in text
+
+
+def raw_manifest(change):
+    def apply(directory):
+        path = directory / "manifest.json"
+        path.write_text(change(path.read_text()))
+    return apply
+
+
+def expectations(change):
+    return lambda d: rewrite_manifest(d, lambda m: change(m["expectations"]))
+
+
+def linked_outside(name):
+    def apply(directory):
+        outside = directory.parent / f"outside-{name}"
+        (directory / name).rename(outside)
+        (directory / name).symlink_to(outside)
+    return apply
+
+
+def widened(expects):
+    expects[0]["tolerance"] = 100
+
+
+# (name, how the directory is damaged, what the one line must say): refused, exit 2.
+REFUSED = [
+    ("tolerance-widened-in-the-manifest", expectations(widened),
+     "expectation 1 is not suite.toml's [[expect]] 1: 'tolerance' is 100 in the manifest, 0.1 in suite.toml"),
+    ("bound-added-in-the-manifest", expectations(lambda e: e[0].update(max_error=1.0)),
+     "'max_error' is 1.0 in the manifest, absent in suite.toml"),
+    ("expectations-dropped", expectations(lambda e: e.clear()),
+     "records 0 expectation(s), and suite.toml's [[expect]] tables give 1 in the full tier"),
+    ("expectation-added", expectations(lambda e: e.append(dict(e[0]))),
+     "records 2 expectation(s), and suite.toml's [[expect]] tables give 1"),
+    ("ci-tier-of-a-suite-without-one", lambda d: rewrite_manifest(d, lambda m: m.__setitem__("tier", "ci")),
+     "give 0 in the ci tier"),
+    ("duplicate-json-key", raw_manifest(lambda t: t.replace('"suite": "synthetic"',
+                                                            '"suite": "synthetic", "suite": "synthetic"')),
+     "the key 'suite' is given twice"),
+    ("nan-literal", raw_manifest(lambda t: t.replace('"wall_time_s": 1.0', '"wall_time_s": NaN', 1)),
+     "NaN is not JSON"),
+    ("infinity-literal", raw_manifest(lambda t: t.replace('"wall_time_s": 1.0', '"wall_time_s": -Infinity', 1)),
+     "-Infinity is not JSON"),
+    ("manifest-linked-outside", linked_outside("manifest.json"), "manifest.json: a symlink to"),
+    ("suite-toml-linked-outside", linked_outside("suite.toml"), "suite.toml: a symlink to"),
+    ("suite-toml-deleted", lambda d: (d / "suite.toml").unlink(), "suite.toml: missing"),
+]
+
+
+@pytest.mark.parametrize("name, damage, said", REFUSED, ids=[c[0] for c in REFUSED])
+def test_a_manifest_that_is_not_its_suites_is_refused(suite_directory, tmp_path, capsys, name, damage, said):
+    """Requirement: expectations that are not the [[expect]] tables suite.toml
+    states for the tier (a band widened, a bound added, an expectation added or
+    dropped), a manifest JSON reads two ways (a key twice, NaN or Infinity), and
+    a manifest.json or suite.toml outside the directory (or none) are refused by
+    the gate and the report alike, with one line naming the item (exit 2)."""
+    damage(suite_directory)
+    for main, arguments in ((gate.main, [str(suite_directory)]),
+                            (report.main, [str(suite_directory), "-q", "-o", str(tmp_path / "r")])):
+        status, text = outcome(main, arguments, capsys)
+        assert status == 2, text
+        assert said in text, text
+        assert len(text.strip().splitlines()) == 1 and "Traceback" not in text
+    assert not (tmp_path / "r" / "report.html").exists()
+
+
+def test_expectations_of_the_tier_are_the_suites(suite_directory, capsys):
+    """Requirement: the manifest's expectations are compared with those of its
+    tier (an [[expect]] without `tier` is the full study's, one with `tier`
+    lists its tiers), keys in any order, 2 and 2.0 the same number."""
+    from .consistency import expectation_problem, suite_expectations
+    suite_file = {"expect": [{"study": "a", "norm": "n", "order": 2, "tolerance": 0.5},
+                             {"study": "a", "norm": "n", "max_error": 1.0, "tier": ["full", "ci"]},
+                             {"study": "a", "norm": "n", "max_error": 2.0, "tier": "ci"}]}
+    assert [e.get("max_error") for e in suite_expectations(suite_file, "full")] == [None, 1.0]
+    assert [e.get("max_error") for e in suite_expectations(suite_file, "ci")] == [1.0, 2.0]
+    recorded = [{"tolerance": 0.5, "order": 2.0, "norm": "n", "study": "a"},
+                {"tier": ["full", "ci"], "max_error": 1, "norm": "n", "study": "a"}]
+    assert expectation_problem(recorded, suite_expectations(suite_file, "full"), "full") == ""
+    recorded[1]["must_complete"] = False
+    assert "'must_complete' is False in the manifest, absent" in \
+        expectation_problem(recorded, suite_expectations(suite_file, "full"), "full")

@@ -259,6 +259,8 @@ def test_ci_tier_is_named_and_its_table_sets_the_varied_keys(tmp_path, capsys):
         'sweep = { method = ["linear", "cpdi"], cells = [32, 64, 128, 256] }',
         'sweep = { method = ["linear", "cpdi"], cells = [32, 64, 128, 256] }\n'
         'ci = { set = { method = "cpdi" }, sweep = { cells = [32, 64, 128], particles_per_direction = [2] } }')
+    # (an expectation without `tier` is the full study's alone: mpmvv suite records it in no ci manifest)
+    suite_toml = suite_toml.replace('norm = "L1_theta0"\n', 'norm = "L1_theta0"\ntier = ["full", "ci"]\n', 1)
     suite_toml += '\n[[reference]]\nsource = "x"\nstudy = "ring"\nquantity = "time_reached"\n' \
                   'columns = ["cells"]\nrows = [[32, 1.0]]\n'
     cases = [c for c in synthetic_ring_cases(linear_fails_at_64=False)
@@ -280,3 +282,19 @@ def test_ci_tier_is_named_and_its_table_sets_the_varied_keys(tmp_path, capsys):
     (directory / "manifest.json").write_text(json.dumps(manifest))
     suite = read_suite(directory)
     assert suite.tier == "full" and suite.varied_keys("ring") == ["method", "cells"] and len(suite.references) == 1
+
+
+def test_a_ci_manifest_of_a_suite_without_a_ci_tier_fails(tmp_path, capsys):
+    """Requirement: "tier": "ci" in the manifest of a suite whose studies have no
+    `ci` table (or whose [ci] says skip) is not a run mpmvv suite made: FAIL,
+    naming the study; the same suite read as the full tier passes."""
+    suite_toml = SYNTHETIC_SUITE.split("[[expect]]")[0]
+    directory = write_suite_directory(tmp_path / "suite", suite_toml, synthetic_ring_cases())
+    manifest = json.loads((directory / "manifest.json").read_text())
+    manifest["tier"] = "ci"
+    (directory / "manifest.json").write_text(json.dumps(manifest))
+    status, out, err = run_gate(directory, capsys)
+    assert status == 1 and "study 'ring' of suite.toml has no `ci` table" in err
+    (directory / "suite.toml").write_text(suite_toml + '[ci]\nskip = "too slow"\n')
+    status, out, err = run_gate(directory, capsys)
+    assert status == 1 and "suite.toml has no ci tier ([ci] skip = 'too slow')" in err

@@ -71,3 +71,55 @@ def finite_or_none(x):
 
 def pytest_fail(message):
     raise AssertionError(message)
+
+
+def test_a_failed_write_is_exit_2_naming_the_file(tmp_path, capsys, monkeypatch):
+    """Requirement: a --json or --junit file the disk refuses (ENOSPC, as
+    /dev/full gives) is exit 2 with one line naming it, never exit 0; an empty
+    file name is refused."""
+    import errno
+
+    from . import gate_files
+    directory = write_suite_directory(tmp_path / "suite", SYNTHETIC_SUITE, synthetic_ring_cases())
+
+    def full(*_):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(gate_files, "write_atomically", full)
+    for option in ("--json", "--junit"):
+        status = gate.main([str(directory), option, str(tmp_path / "verdicts")])
+        err = capsys.readouterr().err
+        assert status == 2 and err.count("\n") == 1, err
+        assert f"cannot write {tmp_path / 'verdicts'}: No space left on device" in err
+        status = gate.main([str(directory), option, ""])
+        err = capsys.readouterr().err
+        assert status == 2 and f"{option} '': an empty file name" in err
+
+
+def test_a_device_or_fifo_is_written_to_not_replaced(tmp_path):
+    """Requirement: a --json path that is not a regular file (a FIFO, /dev/stdout,
+    /dev/full) is written to in place: it is never replaced by a regular file (the
+    atomic rename would have turned /dev/full into one), and its write error is
+    raised."""
+    import os
+    import stat
+    import threading
+
+    from .gate_files import write_atomically
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+    received = []
+    reader = threading.Thread(target=lambda: received.append(fifo.read_text()))
+    reader.start()
+    write_atomically(fifo, "{}\n")
+    reader.join(10)
+    assert received == ["{}\n"] and stat.S_ISFIFO(fifo.stat().st_mode)
+    full = "/dev/full"
+    if os.path.exists(full) and stat.S_ISCHR(os.stat(full).st_mode):
+        try:
+            write_atomically(full, "x" * 10000)
+        except OSError as error:
+            assert error.errno == 28
+        else:
+            raise AssertionError("a write to /dev/full raised nothing")
+        assert stat.S_ISCHR(os.stat(full).st_mode)

@@ -42,3 +42,19 @@ def test_a_report_that_cannot_be_written_leaves_no_empty_folder(tmp_path, monkey
     except OSError:
         pass
     assert not (out / "figures").exists() and not (out / "report.html").exists()
+
+
+def test_an_empty_output_or_no_suite_file_is_refused(tmp_path, capsys):
+    """Requirement: `mpmvv report DIR -o ''` is refused (it would write into the
+    current directory's place, or DIR/report, unasked), and a directory without
+    suite.toml is refused as the gate refuses it: exit 2, one line, no report."""
+    directory = write_suite_directory(tmp_path / "suite", SYNTHETIC_SUITE, synthetic_ring_cases())
+    assert report.main([str(directory), "-q", "-o", ""]) == 2
+    err = capsys.readouterr().err
+    assert "-o '': an empty directory name" in err and err.count("\n") == 1
+    assert not (directory / "report").exists()
+    (directory / "suite.toml").unlink()
+    assert report.main([str(directory), "-q", "-o", str(tmp_path / "r")]) == 2
+    err = capsys.readouterr().err
+    assert "suite.toml: missing" in err and err.count("\n") == 1
+    assert not (tmp_path / "r" / "report.html").exists()

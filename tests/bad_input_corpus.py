@@ -170,6 +170,8 @@ CORPUS = [
      {"manifest.json": '{"cases": [], "expectations": [{"study": "a", "norm": "n", "order": "two", '
                        '"tolerance": 0.1}]}', "suite.toml": STUDY}, "'order' is 'two'"),
     ("gate: tier unknown", ["gate", "{d}"], {"manifest.json": '{"cases": [], "tier": "x"}'}, "'tier'"),
+    ("gate: --json an empty name", ["gate", "{d}", "--json", ""], {"manifest.json": '{"cases": []}'}, "--json"),
+    ("report: -o an empty name", ["report", "{d}", "-o", ""], {"manifest.json": '{"cases": []}'}, "-o ''"),
     ("report: manifest not JSON", ["report", "{d}", "-o", "{d}/r"], {"manifest.json": "["}, "not valid JSON"),
     ("report: suite.toml not TOML", ["report", "{d}", "-o", "{d}/r"],
      {"manifest.json": '{"cases": []}', "suite.toml": "[["}, "not valid TOML"),

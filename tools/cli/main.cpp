@@ -291,15 +291,16 @@ int main(int argc, char** argv) {
   if (suite_cmd->parsed()) return mpmvv::app::run_suite(suite, std::cout, std::cerr);
   if (report_cmd->parsed()) {
     std::vector<std::string> args = {report_dir};
-    if (!report_out.empty()) args.insert(args.end(), {"-o", report_out});
+    // Passed whenever given, an empty one too: the tool refuses it by name.
+    if (report_cmd->count("--output")) args.insert(args.end(), {"-o", report_out});
     if (report_quiet) args.push_back("--quiet");
     return mpmvv::app::run_report_tool("report", args, std::cerr);
   }
   if (results_check_cmd->parsed()) return mpmvv::app::run_report_tool("results_check", results_files, std::cerr);
   if (gate_cmd->parsed()) {
     std::vector<std::string> args = {gate_dir};
-    if (!gate_junit.empty()) args.insert(args.end(), {"--junit", gate_junit});
-    if (!gate_json.empty()) args.insert(args.end(), {"--json", gate_json});
+    if (gate_cmd->count("--junit")) args.insert(args.end(), {"--junit", gate_junit});
+    if (gate_cmd->count("--json")) args.insert(args.end(), {"--json", gate_json});
     return mpmvv::app::run_report_tool("gate", args, std::cerr);
   }
   if (app.got_subcommand("paths")) {
