@@ -208,6 +208,32 @@ def error_problems(results, status):
     return problems
 
 
+# How far a stored L1_<line> column may lie from eq. 3.1 recomputed here from
+# the line's own arrays: the two are one sum in another order (measured
+# agreement about 1e-16), so anything wider is an edited file.
+STORED_NORM_TOLERANCE = 1e-9
+
+
+def probe_norm_problems(path, results):
+    """The L1_<line> columns of /errors that eq. 3.1 on /probes/<line> does not give."""
+    from . import norms, probes  # probes reads results, which imports this module
+    try:
+        lines = probes.read_probe_lines(path)
+    except (OSError, KeyError, ValueError, TypeError):
+        return []  # a damaged probe group: the figures say why; the norms are checked above
+    problems = []
+    for line in lines:
+        stored = results.errors.get("L1_" + line.name)
+        if stored is None:
+            continue
+        recomputed = norms.probe_line_l1(line.simulated, line.exact)[: stored.size]
+        difference = norms.stored_l1_discrepancy(stored, recomputed)
+        if difference > STORED_NORM_TOLERANCE:
+            problems.append(f"/errors/L1_{line.name} is not eq. 3.1 of /probes/{line.name} (they differ by "
+                            f"{difference:.3g}, relative)")
+    return problems
+
+
 def case_problems(entry, status, results):
     """One-line problems of a case whose file was read (`results`, results.CaseResults)."""
     file_status = results.attributes.get("status")

@@ -342,6 +342,7 @@ def _read_case(directory, entry, overridden=()):
                 problems.append(note)
         if results is not None:
             problems += consistency.case_problems(entry, status, results)
+            problems += consistency.probe_norm_problems(results_path, results)
     elif status != "pending":
         note = "no results file"
         if status in consistency.ENDED:

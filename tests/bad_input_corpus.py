@@ -125,6 +125,8 @@ CORPUS = [
      {"s.toml": STUDY + "sweep = { cells = [32, 64] }\n[[study.override]]\nwhere = { cells = 32 }\n"
                         "set = { cfl = 0.2 }\n[[study.override]]\nwhere = {}\nset = { cfl = 0.1 }\n"},
      "both set 'cfl'"),
+    ("suite: [ci] saying nothing", ["suite", "{d}/s.toml", "--list"], {"s.toml": "[ci]\n" + STUDY},
+     "neither 'covers' nor 'skip'"),
     ("suite: timeout inf", ["suite", "{d}/s.toml", "--list"], {"s.toml": "timeout = inf\n" + STUDY}, "'timeout'"),
     ("suite: override without set", ["suite", "{d}/s.toml", "--list"],
      {"s.toml": STUDY + "[[study.override]]\nwhere = { cells = 64 }\n"}, "needs a 'set'"),

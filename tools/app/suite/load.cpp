@@ -35,6 +35,10 @@ void read_ci_table(const toml::table& top, const std::string& path, Suite& suite
       throw ConfigError(fmt::format("{}: [ci] '{}' must be a sentence (a string)", where_in(path, value), key.str()));
     (key.str() == "covers" ? suite.ci_covers : suite.ci_skip) = value.as_string()->get();
   }
+  if (suite.ci_covers.empty() && suite.ci_skip.empty())
+    throw ConfigError(fmt::format("{}: [ci] gives neither 'covers' nor 'skip': say what the ci tier checks that no "
+                                  "other tier does, or why the suite has none",
+                                  where_in(path, *node)));
   if (!suite.ci_covers.empty() && !suite.ci_skip.empty())
     throw ConfigError(fmt::format("{}: [ci] gives both 'covers' and 'skip': a suite has a ci tier or says why not",
                                   where_in(path, *node)));
