@@ -142,7 +142,7 @@ INCONSISTENT = [
     ("key-dropped-from-manifest", drop_key("amplitude"),
      "key 'amplitude' is 0.5 in the results file's configuration, absent from the manifest's keys"),
     ("errors-not-its-probes", with_results(lambda f: f["errors"]["L1_theta0"].__setitem__(
-        slice(None), 0.9 * f["errors"]["L1_theta0"][...])), "/errors/L1_theta0 is not eq. 3.1 of /probes/theta0"),
+        slice(None), 0.9 * f["errors"]["L1_theta0"][...])), "/errors/L1_theta0 is not eq. 3.1 of /probes/theta0 (at row 0"),
     ("suite-named-otherwise", lambda d: rewrite_manifest(d, lambda m: m.__setitem__("suite", "other")),
      "the manifest's suite is 'other', and its suite_file 'suites/synthetic.toml' names the suite 'synthetic'"),
 ]
