@@ -262,6 +262,15 @@ def make_files(directory, files):
             path.write_text(text)
 
 
+def bounded_run(command, directory):
+    """`command` run in `directory`, its output captured; None when it gives no answer within TIMEOUT."""
+    try:
+        return subprocess.run(command, capture_output=True, text=True, timeout=TIMEOUT, cwd=directory,
+                              errors="replace")
+    except subprocess.TimeoutExpired:
+        return None
+
+
 def refused_at_load(mpmvv, what, arguments, files, names):
     """The problems of one input that must be refused with exit 2 (empty: refused as it should be)."""
     with tempfile.TemporaryDirectory() as temporary:
@@ -270,10 +279,8 @@ def refused_at_load(mpmvv, what, arguments, files, names):
         command = [mpmvv] + [a.replace("{d}", str(directory)) for a in arguments]
         if command[1] == "run" and "-o" not in command:
             command += ["-o", str(directory / "x.h5")]
-        try:
-            ran = subprocess.run(command, capture_output=True, text=True, timeout=TIMEOUT, cwd=directory,
-                                 errors="replace")
-        except subprocess.TimeoutExpired:
+        ran = bounded_run(command, directory)
+        if ran is None:
             return f"{what}: no answer within {TIMEOUT} s"
         said = ran.stderr.strip()
         problems = []
@@ -298,10 +305,8 @@ def failed_when_run(mpmvv, what, external_format, program, names):
         command = [mpmvv, "run", RING, "-q", "--set", "cells=32", "--set", "end_time=0.05", "--set",
                    "external_timeout=2", "--set", f"external_format={external_format}", "--set",
                    "external_command=" + program.replace("{d}", str(directory)), "-o", str(directory / "x.h5")]
-        try:
-            ran = subprocess.run(command, capture_output=True, text=True, timeout=TIMEOUT, cwd=directory,
-                                 errors="replace")
-        except subprocess.TimeoutExpired:
+        ran = bounded_run(command, directory)
+        if ran is None:
             return f"{what}: no answer within {TIMEOUT} s"
         said = (ran.stdout + ran.stderr).strip()
         failed = [line for line in said.splitlines() if "FAILED" in line]
